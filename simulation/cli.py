@@ -1,0 +1,101 @@
+"""The ``liansuo`` command line."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from collections.abc import Callable, Sequence
+
+from stations.library import DEFAULT_STATION, bundled, describe
+from stations.loader import load
+from stations.schema import StationFile
+from stations.source import StationError
+from stations.summary import summarise, summary_text
+
+Handler = Callable[[argparse.Namespace], int]
+
+
+def _print_errors(exc: StationError) -> int:
+    for d in exc.diagnostics:
+        print(d, file=sys.stderr)
+    n = len(exc.diagnostics)
+    print(f"{n} error{'s' if n != 1 else ''}; the station was not loaded", file=sys.stderr)
+    return 1
+
+
+def cmd_stations(args: argparse.Namespace) -> int:
+    for name, path in bundled().items():
+        print(f"{name:10} {describe(path)}")
+    return 0
+
+
+def cmd_check(args: argparse.Namespace) -> int:
+    try:
+        station = load(args.station)
+    except StationError as exc:
+        if args.format == "json":
+            print(json.dumps({"station": args.station, "ok": False,
+                              "errors": [d.as_dict() for d in exc.diagnostics]}, ensure_ascii=False, indent=2))
+            return 1
+        return _print_errors(exc)
+    if args.format == "json":
+        print(json.dumps({"ok": True, **summarise(station)}, ensure_ascii=False, indent=2))
+    else:
+        print(summary_text(station))
+    return 0
+
+
+def cmd_schema(args: argparse.Namespace) -> int:
+    schema = StationFile.model_json_schema(by_alias=True)
+    schema["$schema"] = "https://json-schema.org/draft/2020-12/schema"
+    schema["title"] = "liansuo station file"
+    print(json.dumps(schema, ensure_ascii=False, indent=2))
+    return 0
+
+
+def cmd_run_default(args: argparse.Namespace) -> int:
+    """Headless stand-in for the console until it exists: load the default station and print its state."""
+    try:
+        station = load(DEFAULT_STATION)
+    except StationError as exc:
+        return _print_errors(exc)
+    print(summary_text(station))
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="liansuo", description="Station signalling and interlocking simulator (联锁)")
+    sub = p.add_subparsers(dest="command", metavar="COMMAND")
+
+    def add(name: str, handler: Handler, help_: str) -> argparse.ArgumentParser:
+        sp = sub.add_parser(name, help=help_, description=help_)
+        sp.set_defaults(handler=handler)
+        return sp
+
+    add("stations", cmd_stations, "list the bundled stations")
+    sp = add("check", cmd_check, "validate a station file and summarise it")
+    sp.add_argument("station", help="bundled station name or path to a station YAML file")
+    sp.add_argument("--format", choices=("text", "json"), default="text")
+    add("schema", cmd_schema, "print the JSON Schema of the station format")
+    add("run-default", cmd_run_default, "load the default station headless and print its state")
+    return p
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    handler: Handler | None = getattr(args, "handler", None)
+    if handler is None:
+        parser.print_help()
+        return 2
+    try:
+        return handler(args)
+    except BrokenPipeError:  # e.g. piped into head
+        return 0
+    except KeyboardInterrupt:
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,381 @@
+"""Cross-checks a schema-valid station file must pass: references resolve, geometry is consistent, sections are
+bounded by joints or ends, turnout legs connect, signals stand at joints facing a real direction, platforms sit on
+station tracks and the network is connected. Each problem becomes a diagnostic at the offending key."""
+
+from __future__ import annotations
+
+from collections import Counter
+from collections.abc import Iterator, Sequence
+
+import networkx as nx
+
+from .schema import (
+    Button,
+    CircuitType,
+    Direction,
+    EndKind,
+    Lamp,
+    SectionRole,
+    SignalKind,
+    StationFile,
+)
+from .source import Diagnostic, Loc, Source
+from .station import LEGS, Port, parse_port
+
+
+class _Checker:
+    def __init__(self, model: StationFile, src: Source) -> None:
+        self.m = model
+        self.src = src
+        self.errors: list[Diagnostic] = []
+
+    def err(self, loc: Loc, message: str, hint: str = "") -> None:
+        self.errors.append(self.src.diagnostic(loc, message, hint))
+
+    # ---------------------------------------------------------------------------------------------------------
+    def run(self) -> list[Diagnostic]:
+        self.unique_ids()
+        if self.errors:
+            return self.errors
+        self.node_positions = {e.id: e.at for e in self.m.ends}
+        self.node_positions.update({j.id: j.at for j in self.m.joints})
+        self.node_positions.update({t.id: t.at for t in self.m.turnouts})
+        self.ports_resolve()
+        if self.errors:
+            return self.errors
+        self.node_usage()
+        self.geometry()
+        if self.errors:
+            return self.errors
+        self.sections()
+        self.pairs()
+        self.signals()
+        self.standalone_buttons()
+        self.fouling_points()
+        self.platforms()
+        self.links()
+        self.overlaps_and_overrides()
+        if not self.errors:
+            self.connected()
+        return self.errors
+
+    def unique_ids(self) -> None:
+        groups: list[tuple[str, Sequence[object], str]] = [
+            ("ends", self.m.ends, "node"), ("joints", self.m.joints, "node"), ("turnouts", self.m.turnouts, "node"),
+            ("tracks", self.m.tracks, "track"), ("sections", self.m.sections, "section"),
+            ("signals", self.m.signals, "button"), ("buttons", self.m.buttons, "button"),
+            ("fouling_points", self.m.fouling_points, "fouling"), ("platforms", self.m.platforms, "platform"),
+            ("links", self.m.links, "link"),
+        ]
+        seen: dict[tuple[str, str], str] = {}
+        for key, items, space in groups:
+            for i, item in enumerate(items):
+                ident = item.id  # type: ignore[attr-defined]
+                if (space, ident) in seen:
+                    self.err((key, i, "id"), f"id '{ident}' is already used by {seen[(space, ident)]}",
+                             "every end, joint and turnout needs its own id, and so does every signal and button")
+                else:
+                    seen[(space, ident)] = f"{key[:-1]} '{ident}'"
+
+    def ports_resolve(self) -> None:
+        turnouts = {t.id for t in self.m.turnouts}
+        plain = {e.id for e in self.m.ends} | {j.id for j in self.m.joints}
+        for i, t in enumerate(self.m.tracks):
+            for key, ref in (("from", t.start), ("to", t.end)):
+                p = parse_port(ref)
+                if p.leg is not None and p.node in turnouts:
+                    continue
+                if p.leg is None and p.node in plain:
+                    continue
+                if p.node in turnouts or ref in turnouts:
+                    self.err(("tracks", i, key), f"track '{t.id}' attaches to turnout '{p.node}' without naming a leg",
+                             f"write '{p.node}.point', '{p.node}.normal' or '{p.node}.reverse'")
+                else:
+                    self.err(("tracks", i, key), f"track '{t.id}' {key} '{ref}' is not an end, joint or turnout leg",
+                             "declare it under 'ends:', 'joints:' or 'turnouts:', or fix the spelling")
+            if t.start == t.end:
+                self.err(("tracks", i, "to"), f"track '{t.id}' starts and ends at the same place", "")
+
+    def _track_ports(self) -> Iterator[tuple[int, str, Port, Port]]:
+        for i, t in enumerate(self.m.tracks):
+            yield i, t.id, parse_port(t.start), parse_port(t.end)
+
+    def node_usage(self) -> None:
+        use: dict[tuple[str, str | None], list[tuple[int, str]]] = {}
+        for i, tid, a, b in self._track_ports():
+            use.setdefault((a.node, a.leg), []).append((i, "from"))
+            use.setdefault((b.node, b.leg), []).append((i, "to"))
+        for k, e in enumerate(self.m.ends):
+            n = len(use.get((e.id, None), []))
+            if n != 1:
+                self.err(("ends", k, "id"), f"end '{e.id}' has {n} tracks attached; an end takes exactly one",
+                         "connect exactly one track to a buffer stop or boundary")
+        for k, j in enumerate(self.m.joints):
+            n = len(use.get((j.id, None), []))
+            if n != 2:
+                self.err(("joints", k, "id"), f"joint '{j.id}' has {n} tracks attached; a joint joins exactly two",
+                         "a joint sits between the last track of one section and the first of the next")
+        for k, t in enumerate(self.m.turnouts):
+            for leg in LEGS:
+                n = len(use.get((t.id, leg), []))
+                if n != 1:
+                    self.err(("turnouts", k, "id"),
+                             f"turnout {t.id}: its {leg} leg has {n} tracks attached; each leg takes exactly one",
+                             f"connect one track 'from' or 'to' '{t.id}.{leg}'")
+
+    def geometry(self) -> None:
+        pos = self.node_positions
+        for i, tid, a, b in self._track_ports():
+            if pos[a.node] == pos[b.node]:
+                self.err(("tracks", i), f"track '{tid}' has both ends at position {pos[a.node]:g} m",
+                         "positions increase in the down direction; the two ends of a track must differ")
+        if self.errors:
+            return
+        other: dict[tuple[str, str | None], float] = {}
+        for _, _, a, b in self._track_ports():
+            other[(a.node, a.leg)] = pos[b.node]
+            other[(b.node, b.leg)] = pos[a.node]
+        for k, t in enumerate(self.m.turnouts):
+            side = {leg: other[(t.id, leg)] > t.at for leg in LEGS}
+            if side["normal"] != side["reverse"]:
+                self.err(("turnouts", k, "at"),
+                         f"turnout {t.id}: its normal and reverse legs leave on opposite sides of {t.at:g} m",
+                         "both legs leave on the side away from the point; check the positions of their tracks")
+            elif side["point"] == side["normal"]:
+                self.err(("turnouts", k, "at"),
+                         f"turnout {t.id}: the point leg leaves on the same side as the normal and reverse legs",
+                         "the point leg goes one way from the turnout, the normal and reverse legs the other")
+        for k, j in enumerate(self.m.joints):
+            sides = {other[(j.id, None)] > j.at}
+            tracks_here = [t for t in self.m.tracks if parse_port(t.start).node == j.id or parse_port(t.end).node == j.id]
+            positions = []
+            for t in tracks_here:
+                a, b = parse_port(t.start), parse_port(t.end)
+                positions.append(pos[b.node] if a.node == j.id else pos[a.node])
+            sides = {p > j.at for p in positions}
+            if len(sides) != 2:
+                self.err(("joints", k, "at"), f"joint '{j.id}': both its tracks leave on the same side of {j.at:g} m",
+                         "a joint lies between its two tracks; check the positions")
+            if j.at2 is not None and abs(j.at2 - j.at) > 30:
+                self.err(("joints", k, "at2"),
+                         f"joint '{j.id}': the two rail joints are {abs(j.at2 - j.at):g} m apart",
+                         "'at2' is the second rail's joint, normally within a few metres of 'at'")
+
+    def sections(self) -> None:
+        known = {s.id for s in self.m.sections}
+        used: Counter[str] = Counter()
+        for i, t in enumerate(self.m.tracks):
+            if t.section not in known:
+                self.err(("tracks", i, "section"), f"track '{t.id}' is in section '{t.section}', which is not declared",
+                         "add it under 'sections:' with its type (25hz or zpw2000a)")
+            used[t.section] += 1
+        for k, s in enumerate(self.m.sections):
+            if used[s.id] == 0:
+                self.err(("sections", k, "id"), f"section '{s.id}' has no tracks",
+                         "give at least one track 'section: " + s.id + "', or remove the section")
+            if s.type is CircuitType.zpw2000a and s.carrier is None:
+                self.err(("sections", k, "type"), f"ZPW-2000A section '{s.id}' has no carrier",
+                         "add e.g. 'carrier: 2300-1' (down line 1700/2300, up line 2000/2600)")
+            if s.type is CircuitType.phase25hz and s.carrier is not None:
+                self.err(("sections", k, "carrier"), f"25 Hz section '{s.id}' cannot have a ZPW-2000A carrier",
+                         "remove 'carrier', or make the section 'type: zpw2000a'")
+            caps = s.capacitors
+            if caps is not None and sum(x is not None for x in (caps.count, caps.positions, caps.rule)) != 1:
+                self.err(("sections", k, "capacitors"), f"section '{s.id}': give exactly one of count, positions, rule",
+                         "e.g. 'capacitors: {rule: standard}'")
+            if caps is not None and s.type is not CircuitType.zpw2000a:
+                self.err(("sections", k, "capacitors"),
+                         f"section '{s.id}': compensation capacitors belong to ZPW-2000A sections", "")
+        if self.errors:
+            return
+        # sections are bounded by joints or ends: tracks meeting at a turnout share a section, tracks meeting at a
+        # joint do not, and the tracks of a section are connected through turnouts.
+        by_node: dict[str, list[tuple[int, str]]] = {}
+        for i, _, a, b in self._track_ports():
+            by_node.setdefault(a.node, []).append((i, "from"))
+            by_node.setdefault(b.node, []).append((i, "to"))
+        joints = {j.id for j in self.m.joints}
+        turnouts = {t.id for t in self.m.turnouts}
+        g = nx.Graph()
+        for t in self.m.tracks:
+            g.add_node(t.id)
+        for node, items in by_node.items():
+            secs = {self.m.tracks[i].section for i, _ in items}
+            if node in joints and len(items) == 2 and len(secs) == 1:
+                i, key = items[1]
+                self.err(("tracks", i, key), f"joint '{node}' has section '{secs.pop()}' on both sides",
+                         "a joint separates two sections; put the tracks in different sections or remove the joint")
+            if node in turnouts:
+                if len(secs) > 1:
+                    i, key = items[0]
+                    self.err(("tracks", i, key),
+                             f"turnout {node} has tracks of different sections ({', '.join(sorted(secs))}) on its legs",
+                             "a turnout lies inside one section: put its three leg tracks in the same section, "
+                             "or place joints between them")
+                for a_, b_ in zip(items, items[1:], strict=False):
+                    g.add_edge(self.m.tracks[a_[0]].id, self.m.tracks[b_[0]].id)
+        for k, s in enumerate(self.m.sections):
+            tracks = [t.id for t in self.m.tracks if t.section == s.id]
+            if len(tracks) > 1 and not nx.is_connected(g.subgraph(tracks)):
+                self.err(("sections", k, "id"),
+                         f"section '{s.id}' is in pieces: its tracks ({', '.join(tracks)}) are not joined through "
+                         "turnouts", "each section is one stretch bounded by joints or ends; split it in two ids")
+
+    def pairs(self) -> None:
+        members: dict[str, list[int]] = {}
+        for k, t in enumerate(self.m.turnouts):
+            if t.pair:
+                members.setdefault(t.pair, []).append(k)
+        for pair, ks in members.items():
+            if len(ks) != 2:
+                self.err(("turnouts", ks[0], "pair"), f"crossover pair '{pair}' has {len(ks)} turnout(s), not 2",
+                         "a pair ('1/3') is exactly two turnouts moved by one command")
+                continue
+            a, b = (self.m.turnouts[k].id for k in ks)
+            if not self._reverse_legs_meet(a, b):
+                self.err(("turnouts", ks[1], "pair"),
+                         f"turnouts {a} and {b} form pair '{pair}' but their reverse legs are not joined",
+                         "a crossover pair's reverse legs are connected by the crossover track (through joints only)")
+
+    def _reverse_legs_meet(self, a: str, b: str) -> bool:
+        # walk from a.reverse through tracks and joints only
+        ports = {t.id: (parse_port(t.start), parse_port(t.end)) for t in self.m.tracks}
+        at = Port(a, "reverse")
+        seen = set()
+        while True:
+            track = next((tid for tid, (p, q) in ports.items() if (p == at or q == at) and tid not in seen), None)
+            if track is None:
+                return False
+            seen.add(track)
+            p, q = ports[track]
+            far = q if p == at else p
+            if far == Port(b, "reverse"):
+                return True
+            if far.leg is not None or far.node not in {j.id for j in self.m.joints}:
+                return False
+            at = far
+
+    def signals(self) -> None:
+        joints = {j.id for j in self.m.joints}
+        ends = {e.id: e for e in self.m.ends}
+        for k, s in enumerate(self.m.signals):
+            if s.at in ends:
+                e = ends[s.at]
+                if e.kind is not EndKind.boundary:
+                    self.err(("signals", k, "at"), f"signal {s.id} stands at buffer stop '{s.at}'",
+                             "signals stand at joints (or at a boundary end facing into the station)")
+                    continue
+                track = next(t for t in self.m.tracks if s.at in (parse_port(t.start).node, parse_port(t.end).node))
+                a, b = parse_port(track.start), parse_port(track.end)
+                far = self.node_positions[b.node if a.node == s.at else a.node]
+                into_down = far > e.at
+                if into_down != (s.direction is Direction.down):
+                    self.err(("signals", k, "direction"),
+                             f"signal {s.id} at boundary '{s.at}' faces {s.direction.value}, out of the station",
+                             "a signal at a boundary governs movements into the station")
+            elif s.at not in joints:
+                self.err(("signals", k, "at"), f"signal {s.id} stands at '{s.at}', which is not a joint",
+                         "every signal stands at an insulated or electrical joint listed under 'joints:'")
+            lamps = set(s.lamps)
+            if s.kind is SignalKind.shunting:
+                if Lamp.B not in lamps or not ({Lamp.A, Lamp.H} & lamps):
+                    self.err(("signals", k, "lamps"), f"shunting signal {s.id} needs a moon-white B and a blue A "
+                             "(or red H) lamp", "e.g. 'lamps: [A, B]'")
+            elif Lamp.H not in lamps:
+                self.err(("signals", k, "lamps"), f"{s.kind.value} signal {s.id} has no red H lamp",
+                         "train signals show H when closed; add H to 'lamps'")
+            if s.usu and not ({Lamp.U, Lamp.U2} <= lamps):
+                self.err(("signals", k, "usu"), f"signal {s.id} may show USU but lacks a U or U2 lamp",
+                         "USU needs the yellow (U) and second yellow (U2) lamps")
+            if s.usu and s.kind not in (SignalKind.home, SignalKind.route):
+                self.err(("signals", k, "usu"), f"only home and route signals show USU, not {s.kind.value} {s.id}", "")
+            if Button.train in s.buttons and s.kind in (SignalKind.shunting, SignalKind.block):
+                self.err(("signals", k, "buttons"), f"{s.kind.value} signal {s.id} cannot have a train button", "")
+            if s.kind is SignalKind.shunting and Button.shunt not in s.buttons and s.buttons:
+                self.err(("signals", k, "buttons"), f"shunting signal {s.id} needs a shunt button", "")
+            for m, sec in enumerate(s.approach or []):
+                if sec not in {x.id for x in self.m.sections}:
+                    self.err(("signals", k, "approach", m), f"signal {s.id}: approach section '{sec}' not declared", "")
+
+    def standalone_buttons(self) -> None:
+        nodes = {j.id for j in self.m.joints} | {e.id for e in self.m.ends}
+        tracks = {t.id for t in self.m.tracks}
+        for k, b in enumerate(self.m.buttons):
+            ok = b.at in tracks if b.kind == "variant" else b.at in nodes
+            if not ok:
+                where = "a track" if b.kind == "variant" else "a joint or an end"
+                self.err(("buttons", k, "at"), f"button {b.id} ({b.kind}) is at '{b.at}', which is not {where}", "")
+
+    def fouling_points(self) -> None:
+        tracks = {t.id: t for t in self.m.tracks}
+        for k, f in enumerate(self.m.fouling_points):
+            if f.track not in tracks:
+                self.err(("fouling_points", k, "track"), f"fouling point {f.id} is on unknown track '{f.track}'", "")
+                continue
+            t = tracks[f.track]
+            xa = self.node_positions[parse_port(t.start).node]
+            xb = self.node_positions[parse_port(t.end).node]
+            if not min(xa, xb) <= f.at <= max(xa, xb):
+                self.err(("fouling_points", k, "at"),
+                         f"fouling point {f.id} at {f.at:g} m is off track '{t.id}' ({min(xa, xb):g}-{max(xa, xb):g} m)",
+                         "a fouling point lies on its track, between the track's two ends")
+
+    def platforms(self) -> None:
+        sections = {s.id: s for s in self.m.sections}
+        for k, p in enumerate(self.m.platforms):
+            s = sections.get(p.section)
+            if s is None:
+                self.err(("platforms", k, "section"), f"platform {p.id} is at unknown section '{p.section}'", "")
+            elif s.role is not SectionRole.station_track:
+                self.err(("platforms", k, "section"),
+                         f"platform {p.id} is at section '{p.section}', which is not a station track",
+                         "platforms and their screen doors stand at station tracks ('role: station_track')")
+            sides = [d.side for d in p.screen_doors]
+            if len(sides) != len(set(sides)):
+                self.err(("platforms", k, "screen_doors"), f"platform {p.id} lists a side twice", "")
+
+    def links(self) -> None:
+        ends = {e.id: e for e in self.m.ends}
+        sections = {s.id for s in self.m.sections}
+        for k, lk in enumerate(self.m.links):
+            e = ends.get(lk.end)
+            if e is None or e.kind is not EndKind.boundary:
+                self.err(("links", k, "end"), f"link {lk.id} leaves from '{lk.end}', which is not a boundary end",
+                         "block links leave the station at an end of 'kind: boundary'")
+            for m, sec in enumerate(lk.sections):
+                if sec not in sections:
+                    self.err(("links", k, "sections", m), f"link {lk.id}: section '{sec}' is not declared", "")
+
+    def overlaps_and_overrides(self) -> None:
+        signals = {s.id for s in self.m.signals}
+        sections = {s.id for s in self.m.sections}
+        turnouts = {t.id for t in self.m.turnouts}
+        for k, o in enumerate(self.m.overlaps):
+            if o.end_signal not in signals:
+                self.err(("overlaps", k, "end_signal"), f"overlap at unknown signal '{o.end_signal}'", "")
+            for m, sec in enumerate(o.sections):
+                if sec not in sections:
+                    self.err(("overlaps", k, "sections", m), f"overlap section '{sec}' is not declared", "")
+            for m, t in enumerate(o.turnouts or []):
+                if t.turnout not in turnouts:
+                    self.err(("overlaps", k, "turnouts", m), f"overlap turnout '{t.turnout}' is not declared", "")
+        for key in ("protection", "remove_protection"):
+            for m, p in enumerate(getattr(self.m.overrides, key)):
+                if p.turnout not in turnouts:
+                    self.err(("overrides", key, m, "turnout"), f"override names unknown turnout '{p.turnout}'", "")
+
+    def connected(self) -> None:
+        g = nx.Graph()
+        for _, tid, a, b in self._track_ports():
+            g.add_edge(("n", a.node), ("t", tid))
+            g.add_edge(("t", tid), ("n", b.node))
+        if not nx.is_connected(g):
+            parts = sorted(nx.connected_components(g), key=len, reverse=True)
+            stray = sorted(x[1] for x in parts[1] if x[0] == "t")
+            i = next(i for i, t in enumerate(self.m.tracks) if t.id == stray[0])
+            self.err(("tracks", i), f"the network is in {len(parts)} pieces; tracks {', '.join(stray)} are cut off "
+                     "from the rest", "connect them through a joint or turnout, or remove them")
+
+
+def cross_check(model: StationFile, src: Source) -> list[Diagnostic]:
+    return _Checker(model, src).run()

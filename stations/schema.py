@@ -1,0 +1,340 @@
+"""The station file format (pydantic v2, strict: unknown keys are errors).
+
+One file describes one station. Positions are metres along the line from the station origin, increasing in the down
+direction (下行), or kilometre posts such as ``K12+345.6`` (= 12345.6 m). Ids are those of the
+station diagram (站场图): signals ``X``, ``SI``, ``D3``; turnouts ``1``, ``3``; sections ``IG``, ``1DG``, ``IAG``.
+"""
+
+from __future__ import annotations
+
+import re
+from enum import StrEnum
+from typing import Annotated, Literal
+
+from pydantic import AfterValidator, BaseModel, BeforeValidator, ConfigDict, Field
+
+_ID_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_\-/]*$")
+_KM_RE = re.compile(r"^K(\d+)\+(\d+(?:\.\d+)?)$")
+
+
+def _to_id(value: object) -> object:
+    if isinstance(value, bool):
+        return value  # rejected below with a clear message
+    if isinstance(value, int):
+        return str(value)
+    return value
+
+
+def _check_id(value: str) -> str:
+    if not _ID_RE.match(value):
+        raise ValueError(f"'{value}' is not a valid id: use letters, digits, '-', '_' or '/', starting with a "
+                         "letter or digit")
+    return value
+
+
+Id = Annotated[str, BeforeValidator(_to_id), AfterValidator(_check_id)]
+
+
+def parse_km(text: str) -> float:
+    """``K12+345.6`` -> 12345.6 metres."""
+    m = _KM_RE.match(text.strip())
+    if not m:
+        raise ValueError(f"'{text}' is not a position: write metres (e.g. 350.5) or a kilometre post (K12+345.6)")
+    return int(m.group(1)) * 1000 + float(m.group(2))
+
+
+def _position(value: object) -> object:
+    if isinstance(value, bool):
+        raise ValueError("a position is a number of metres or a kilometre post like K12+345.6, not true/false")
+    if isinstance(value, str):
+        return parse_km(value)
+    if isinstance(value, int):
+        return float(value)
+    return value
+
+
+# A position: metres along the line, or a kilometre post ``K12+345.6``.
+Position = Annotated[float, BeforeValidator(_position)]
+Metres = Annotated[float, Field(gt=0), BeforeValidator(lambda v: float(v) if type(v) is int else v)]
+
+
+class Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", strict=True, frozen=True)
+
+
+class Direction(StrEnum):
+    """下行 down trains run towards increasing positions (enter at the X end); 上行 up the other way."""
+
+    down = "down"
+    up = "up"
+
+
+class Name(Strict):
+    """Display name, kept apart from the id so a station rename is a data-only change."""
+
+    zh: str = Field(min_length=1)
+    en: str = Field(min_length=1)
+
+
+class Draw(Strict):
+    """Optional schematic coordinates (columns, rows) for the console's station diagram."""
+
+    x: float
+    y: float
+
+
+class EndKind(StrEnum):
+    buffer = "buffer"  # 车挡
+    boundary = "boundary"  # 站界 / line continues to a neighbour station
+
+
+class End(Strict):
+    """A buffer stop or the boundary where the line leaves the station model."""
+
+    id: Id
+    kind: EndKind
+    at: Position
+    draw: Draw | None = None
+
+
+class JointKind(StrEnum):
+    insulated = "insulated"  # 绝缘节
+    electrical = "electrical"  # 电气绝缘节 (ZPW-2000A tuning area)
+
+
+class Joint(Strict):
+    """An insulated or electrical joint separating two track-circuit sections.
+
+    ``at`` is the first rail's joint; ``at2`` the second rail's where they are staggered (错开): the stretch between
+    them is a dead zone (死区段) where a wheelset shunts nothing.
+    """
+
+    id: Id
+    at: Position
+    at2: Position | None = None
+    kind: JointKind = JointKind.insulated
+    tuning_area_m: Metres | None = None
+    dead_zone_m: Annotated[float, Field(ge=0)] | None = None
+    draw: Draw | None = None
+
+
+class Machine(StrEnum):
+    ZD6 = "ZD6"
+    ZDJ9 = "ZDJ9"
+    S700K = "S700K"
+
+
+class Turnout(Strict):
+    """A turnout (道岔): its point leg on one side, normal (定位) and reverse (反位) legs on the other."""
+
+    id: Id
+    at: Position
+    number: Annotated[int, Field(ge=6, le=62)]
+    machine: Machine
+    pair: Id | None = None  # crossover pair moved by one command, e.g. '1/3' (双动道岔)
+    trailable: bool = True
+    draw: Draw | None = None
+
+
+class Track(Strict):
+    """A piece of track between two nodes (end, joint or turnout leg such as ``1.normal``)."""
+
+    id: Id
+    start: str = Field(alias="from")
+    end: str = Field(alias="to")
+    section: Id
+    length: Metres | None = None
+    row: float | None = None  # schematic row, 0 = the main line
+
+    model_config = ConfigDict(extra="forbid", strict=True, frozen=True, populate_by_name=True)
+
+
+class CircuitType(StrEnum):
+    phase25hz = "25hz"  # 97型 25 Hz 相敏轨道电路
+    zpw2000a = "zpw2000a"  # ZPW-2000A 无绝缘移频
+
+
+class SectionRole(StrEnum):
+    station_track = "station_track"  # 股道
+    throat = "throat"  # turnout and other sections of the throat (咽喉区)
+    approach = "approach"  # 接近区段
+    departure = "departure"  # 离去区段
+    block = "block"  # automatic block section (闭塞分区)
+    spur = "spur"  # 尽头线
+
+
+class Capacitors(Strict):
+    """Compensation capacitors (补偿电容): explicit positions (metres from the section's lower end), a count placed
+    by the standard rule, or ``rule: standard`` (about every 100 m, half a spacing at the ends, only over 300 m)."""
+
+    count: Annotated[int, Field(ge=0, le=60)] | None = None
+    positions: list[Annotated[float, Field(ge=0)]] | None = None
+    rule: Literal["standard"] | None = None
+    capacitance_uF: Annotated[float, Field(gt=0)] | None = None
+
+
+_CARRIER_RE = re.compile(r"^(1700|2000|2300|2600)-(1|2)$")
+
+
+def _check_carrier(value: str) -> str:
+    if not _CARRIER_RE.match(value):
+        raise ValueError(f"'{value}' is not a ZPW-2000A carrier: use 1700, 2000, 2300 or 2600 with -1 or -2, "
+                         "e.g. '2300-1'")
+    return value
+
+
+Carrier = Annotated[str, BeforeValidator(_to_id), AfterValidator(_check_carrier)]
+
+
+class Section(Strict):
+    """A track-circuit section (轨道电路区段)."""
+
+    id: Id
+    type: CircuitType
+    role: SectionRole = SectionRole.throat
+    carrier: Carrier | None = None
+    coded: bool = False  # 电码化: carries cab-signal codes
+    capacitors: Capacitors | None = None
+    speed_kmh: Annotated[float, Field(gt=0, le=400)] | None = None
+    name: str | None = None
+
+
+class SignalKind(StrEnum):
+    home = "home"  # 进站
+    starting = "starting"  # 出站
+    route = "route"  # 进路
+    shunting = "shunting"  # 调车
+    block = "block"  # 通过 (automatic block)
+
+
+class Lamp(StrEnum):
+    L = "L"  # green
+    U = "U"  # yellow
+    U2 = "U2"  # second yellow
+    H = "H"  # red
+    B = "B"  # moon-white
+    A = "A"  # blue
+    L2 = "L2"  # second green (LL)
+
+
+class Button(StrEnum):
+    train = "train"  # 列车按钮 LA
+    shunt = "shunt"  # 调车按钮 DA
+
+
+class Signal(Strict):
+    """A colour-light signal standing at a joint (or end), governing movements in ``direction``."""
+
+    id: Id
+    kind: SignalKind
+    at: Id
+    direction: Direction
+    lamps: list[Lamp] = Field(min_length=1)
+    usu: bool = False  # may show the flashing yellow USU (needs a U and a U2 lamp)
+    buttons: list[Button] = Field(default_factory=list)
+    release_s: Annotated[float, Field(gt=0)] | None = None  # manual release delay override
+    approach: list[Id] | None = None  # override of the approach section(s) (接近区段)
+    draw: Draw | None = None
+
+
+class StandaloneButton(Strict):
+    """A button not on a signal: a departure end (发车口) or a variant button (变通按钮)."""
+
+    id: Id
+    at: Id  # a joint, an end, or for variant buttons a track
+    kind: Literal["exit", "variant", "end"]
+    direction: Direction | None = None
+
+
+class FoulingPoint(Strict):
+    """A fouling point (警冲标) on a track."""
+
+    id: Id
+    track: Id
+    at: Position
+
+
+class Side(StrEnum):
+    left = "left"
+    right = "right"
+
+
+class ScreenDoors(Strict):
+    """Platform screen doors (站台门) on one side of a platform track."""
+
+    side: Side
+    doors: Annotated[int, Field(ge=1, le=64)] = 8
+
+
+class Platform(Strict):
+    id: Id
+    section: Id
+    screen_doors: list[ScreenDoors] = Field(default_factory=list)
+    stop_window_m: Annotated[float, Field(gt=0)] = 0.5
+    name: str | None = None
+
+
+class LinkKind(StrEnum):
+    semi_auto_64d = "64d"  # 64D 半自动闭塞
+    automatic = "automatic"  # 自动闭塞
+
+
+class Link(Strict):
+    """A block link to a neighbour station (区间闭塞)."""
+
+    id: Id
+    kind: LinkKind
+    end: Id  # the boundary end the link leaves from
+    neighbour: Name
+    sections: list[Id] = Field(default_factory=list)  # block/departure sections, nearest first
+
+
+class TurnoutPosition(StrEnum):
+    normal = "normal"
+    reverse = "reverse"
+
+
+class ProtectionOverride(Strict):
+    route: Id
+    turnout: Id
+    position: TurnoutPosition
+
+
+class Overrides(Strict):
+    """What topology alone cannot decide: extra protection turnouts, routes that must not exist."""
+
+    protection: list[ProtectionOverride] = Field(default_factory=list)
+    remove_protection: list[ProtectionOverride] = Field(default_factory=list)
+    forbid: list[Id] = Field(default_factory=list)
+
+
+class Overlap(Strict):
+    """An overlap (延续进路) beyond the end signal of receiving routes, where the file asks for one."""
+
+    end_signal: Id
+    sections: list[Id] = Field(min_length=1)
+    turnouts: list[ProtectionOverride] | None = None
+    release_s: Annotated[float, Field(gt=0)] = 180.0
+
+
+class StationFile(Strict):
+    """The whole station description."""
+
+    id: Id
+    name: Name
+    description: str = ""
+    line: Literal["single", "double"] = "single"
+    line_speed_kmh: Annotated[float, Field(gt=0, le=400)] = 120.0
+    emu: bool = False  # EMUs call here: fouling-point clearance 5 m
+    ends: list[End] = Field(min_length=1)
+    joints: list[Joint] = Field(default_factory=list)
+    turnouts: list[Turnout] = Field(default_factory=list)
+    tracks: list[Track] = Field(min_length=1)
+    sections: list[Section] = Field(min_length=1)
+    signals: list[Signal] = Field(default_factory=list)
+    buttons: list[StandaloneButton] = Field(default_factory=list)
+    fouling_points: list[FoulingPoint] = Field(default_factory=list)
+    platforms: list[Platform] = Field(default_factory=list)
+    links: list[Link] = Field(default_factory=list)
+    overlaps: list[Overlap] = Field(default_factory=list)
+    overrides: Overrides = Field(default_factory=Overrides)

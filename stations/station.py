@@ -1,0 +1,203 @@
+"""A validated station: the file's model plus indices and the topology built from it."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property
+from typing import TYPE_CHECKING
+
+from .schema import (
+    Direction,
+    End,
+    Joint,
+    Section,
+    SectionRole,
+    Signal,
+    StandaloneButton,
+    StationFile,
+    Track,
+    Turnout,
+)
+from .source import Diagnostic, Source
+
+if TYPE_CHECKING:
+    from .topology import Topology
+
+LEGS = ("point", "normal", "reverse")
+
+
+@dataclass(frozen=True)
+class Port:
+    """Where a track end attaches: a node (end, joint or turnout) and, for turnouts, the leg."""
+
+    node: str
+    leg: str | None = None
+
+    def __str__(self) -> str:
+        return f"{self.node}.{self.leg}" if self.leg else self.node
+
+
+def parse_port(ref: str) -> Port:
+    """``'1.normal'`` -> Port('1', 'normal'); ``'J3'`` -> Port('J3')."""
+    head, dot, leg = ref.rpartition(".")
+    if dot and leg in LEGS:
+        return Port(head, leg)
+    return Port(ref)
+
+
+@dataclass(frozen=True)
+class DeadZone:
+    """The stretch between the staggered rail joints of one joint (死区段)."""
+
+    joint: str
+    start: float
+    end: float
+
+    @property
+    def length(self) -> float:
+        return self.end - self.start
+
+
+class Station:
+    """A station file that passed the schema and every cross-check."""
+
+    def __init__(self, model: StationFile, source: Source | None = None) -> None:
+        self.model = model
+        self.source = source
+        self.warnings: list[Diagnostic] = []
+        self.id = model.id
+        self.ends: dict[str, End] = {e.id: e for e in model.ends}
+        self.joints: dict[str, Joint] = {j.id: j for j in model.joints}
+        self.turnouts: dict[str, Turnout] = {t.id: t for t in model.turnouts}
+        self.tracks: dict[str, Track] = {t.id: t for t in model.tracks}
+        self.sections: dict[str, Section] = {s.id: s for s in model.sections}
+        self.signals: dict[str, Signal] = {s.id: s for s in model.signals}
+        self.buttons: dict[str, StandaloneButton] = {b.id: b for b in model.buttons}
+        # track ends
+        self.track_ports: dict[str, tuple[Port, Port]] = {
+            t.id: (parse_port(t.start), parse_port(t.end)) for t in model.tracks
+        }
+        # node -> {leg or track id: track id}
+        self.node_tracks: dict[str, list[tuple[str | None, str]]] = {}
+        for tid, ports in self.track_ports.items():
+            for p in ports:
+                self.node_tracks.setdefault(p.node, []).append((p.leg, tid))
+        self.section_tracks: dict[str, list[str]] = {}
+        for t in model.tracks:
+            self.section_tracks.setdefault(t.section, []).append(t.id)
+        self.turnout_section: dict[str, str] = {}
+        for tid, (a, b) in self.track_ports.items():
+            for p in (a, b):
+                if p.leg is not None:
+                    self.turnout_section[p.node] = self.tracks[tid].section
+        self.pairs: dict[str, list[str]] = {}
+        for t in model.turnouts:
+            if t.pair:
+                self.pairs.setdefault(t.pair, []).append(t.id)
+
+    # ---- geometry -------------------------------------------------------------------------------------------
+    def node_at(self, node: str) -> float:
+        if node in self.ends:
+            return self.ends[node].at
+        if node in self.joints:
+            return self.joints[node].at
+        return self.turnouts[node].at
+
+    def track_span(self, track: str) -> tuple[float, float]:
+        a, b = self.track_ports[track]
+        xa, xb = self.node_at(a.node), self.node_at(b.node)
+        return (xa, xb) if xa <= xb else (xb, xa)
+
+    def track_length(self, track: str) -> float:
+        t = self.tracks[track]
+        if t.length is not None:
+            return t.length
+        lo, hi = self.track_span(track)
+        return hi - lo
+
+    def track_low_port(self, track: str) -> Port:
+        """The port of ``track`` at its lower position (towards the X end)."""
+        a, b = self.track_ports[track]
+        return a if self.node_at(a.node) <= self.node_at(b.node) else b
+
+    def track_high_port(self, track: str) -> Port:
+        a, b = self.track_ports[track]
+        return b if self.node_at(a.node) <= self.node_at(b.node) else a
+
+    def section_length(self, section: str) -> float:
+        return sum(self.track_length(t) for t in self.section_tracks[section])
+
+    def joint_tracks(self, joint: str) -> tuple[str, str]:
+        """(track on the low side, track on the high side) of a joint."""
+        tracks = [tid for _, tid in self.node_tracks[joint]]
+        low = [t for t in tracks if self.track_high_port(t).node == joint]
+        high = [t for t in tracks if self.track_low_port(t).node == joint]
+        return low[0], high[0]
+
+    def joint_sections(self, joint: str) -> tuple[str, str]:
+        lo, hi = self.joint_tracks(joint)
+        return self.tracks[lo].section, self.tracks[hi].section
+
+    def leg_track(self, turnout: str, leg: str) -> str:
+        for lg, tid in self.node_tracks[turnout]:
+            if lg == leg:
+                return tid
+        raise KeyError(f"{turnout}.{leg}")
+
+    def turnout_points_down(self, turnout: str) -> bool:
+        """True when a down movement runs point -> normal/reverse (facing for down trains)."""
+        track = self.leg_track(turnout, "point")
+        return self.track_high_port(track).node == turnout
+
+    @cached_property
+    def dead_zones(self) -> list[DeadZone]:
+        out = []
+        for j in self.model.joints:
+            if j.at2 is not None and j.at2 != j.at:
+                out.append(DeadZone(j.id, min(j.at, j.at2), max(j.at, j.at2)))
+            elif j.dead_zone_m:
+                out.append(DeadZone(j.id, j.at - j.dead_zone_m / 2, j.at + j.dead_zone_m / 2))
+        return out
+
+    # ---- signals -------------------------------------------------------------------------------------------
+    def signal_entry_track(self, signal: str) -> str:
+        """The first track a movement passing ``signal`` enters."""
+        sig = self.signals[signal]
+        return self.entry_track(sig.at, sig.direction)
+
+    def entry_track(self, node: str, direction: Direction) -> str:
+        if node in self.joints:
+            lo, hi = self.joint_tracks(node)
+            return hi if direction is Direction.down else lo
+        # an end: its single track
+        return self.node_tracks[node][0][1]
+
+    def signal_rear_track(self, signal: str) -> str | None:
+        """The track a movement stands on in rear of ``signal`` (its approach side), if inside the model."""
+        sig = self.signals[signal]
+        if sig.at in self.joints:
+            lo, hi = self.joint_tracks(sig.at)
+            return lo if sig.direction is Direction.down else hi
+        return None
+
+    def approach_sections(self, signal: str) -> list[str]:
+        sig = self.signals[signal]
+        if sig.approach:
+            return list(sig.approach)
+        rear = self.signal_rear_track(signal)
+        return [self.tracks[rear].section] if rear else []
+
+    def signals_at(self, node: str) -> list[Signal]:
+        return [s for s in self.model.signals if s.at == node]
+
+    def is_station_track(self, section: str) -> bool:
+        return self.sections[section].role is SectionRole.station_track
+
+    def display_name(self) -> str:
+        return f"{self.model.name.zh} ({self.model.name.en})"
+
+    @cached_property
+    def topology(self) -> Topology:
+        from .topology import Topology  # built on first use; the graph is not needed to check a file
+
+        return Topology(self)
