@@ -1,0 +1,90 @@
+"""64D semi-automatic block (64D 半自动闭塞) between this station and a neighbour, from this station's side.
+
+The two block machines talk by line pulses (each sent for a few seconds): REQUEST (闭塞请求), ACCEPT (同意),
+DEPART (出发通知), RESTORE (到达复原 / 取消复原), ACCIDENT (事故复原). Departure needs the neighbour's acceptance; once the
+train occupies the departure section the line is blocked until the neighbour restores it after the arrival.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from enum import StrEnum
+
+
+class BlockState(StrEnum):
+    idle = "idle"  # 定位: line clear, no block
+    requested = "requested"  # we asked to send a train; waiting for ACCEPT
+    permitted = "permitted"  # neighbour accepted: our starting signal may open (发车表示灯绿)
+    departed = "departed"  # our train is on the line (区间占用)
+    asked = "asked"  # the neighbour asks to send us a train
+    accepted = "accepted"  # we accepted (接车表示灯绿)
+    arriving = "arriving"  # the neighbour's train is on the line towards us (接车表示灯红)
+    arrived = "arrived"  # it arrived complete; waiting for our RESTORE
+
+
+REQUEST, ACCEPT, DEPART, RESTORE, ACCIDENT = "request", "accept", "depart", "restore", "accident"
+
+
+@dataclass
+class BlockLink:
+    id: str
+    departure_section: str  # the section a departing train occupies first (and an arriving train last)
+    state: BlockState = BlockState.idle
+    accidents: int = 0  # the accident button is counted, as on the real console
+
+    # ---- operator actions: return (refusal or '', pulse to send or '') ------------------------------------------
+    def operate(self, action: str) -> tuple[str, str]:
+        s = self.state
+        if action == "request":
+            if s is not BlockState.idle:
+                return f"block line {self.id} is not clear ({s.value}); a request needs the line in its normal state", ""
+            self.state = BlockState.requested
+            return "", REQUEST
+        if action == "accept":
+            if s is not BlockState.asked:
+                return f"block line {self.id}: the neighbour has not asked to send a train ({s.value})", ""
+            self.state = BlockState.accepted
+            return "", ACCEPT
+        if action == "cancel":
+            if s not in (BlockState.requested, BlockState.permitted, BlockState.accepted):
+                return f"block line {self.id}: nothing to cancel before a departure ({s.value})", ""
+            self.state = BlockState.idle
+            return "", RESTORE
+        if action == "restore":
+            if s is not BlockState.arrived:
+                return (f"block line {self.id}: restore (复原) only after the train has arrived complete "
+                        f"({s.value}); use 'accident' to force it"), ""
+            self.state = BlockState.idle
+            return "", RESTORE
+        if action == "accident":
+            self.state = BlockState.idle
+            self.accidents += 1
+            return "", ACCIDENT
+        return f"unknown block-line action '{action}': use request, accept, cancel, restore or accident", ""
+
+    # ---- pulses from the neighbour ------------------------------------------------------------------------------
+    def receive(self, pulse: str) -> None:
+        s = self.state
+        if pulse == ACCIDENT:
+            self.state = BlockState.idle
+        elif pulse == REQUEST and s is BlockState.idle:
+            self.state = BlockState.asked
+        elif pulse == ACCEPT and s is BlockState.requested:
+            self.state = BlockState.permitted
+        elif pulse == DEPART and s is BlockState.accepted:
+            self.state = BlockState.arriving
+        elif pulse == RESTORE and s in (BlockState.departed, BlockState.asked, BlockState.requested,
+                                        BlockState.permitted):
+            self.state = BlockState.idle
+
+    # ---- what the trains do -------------------------------------------------------------------------------------
+    def departure_section_occupied(self) -> str:
+        """Our train entered the line: returns the pulse to send (DEPART) if this was a departure."""
+        if self.state is BlockState.permitted:
+            self.state = BlockState.departed
+            return DEPART
+        return ""
+
+    def arrival_complete(self) -> None:
+        if self.state is BlockState.arriving:
+            self.state = BlockState.arrived

@@ -1,0 +1,577 @@
+"""The cycle-based computer interlocking (CBI).
+
+Each cycle reads the relay board (inputs that changed since the last cycle), advances the routes in progress, and
+writes turnout, signal, door, cab-code and line outputs. It never reads the wall clock (``cycle(t)`` is given the
+simulated time) and never sees trains: only track relays. Work per cycle is proportional to what is in progress
+(active routes, moving turnouts, changed inputs), not to the size of the station.
+
+Evaluation order per cycle (as in one real CBI): inputs -> signal-passed-at-danger check against last cycle's
+aspects -> 64D line -> turnout supervision and the move queue -> routes in order of selection -> automatic block
+signals -> cab codes.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+
+from stations.schema import SignalKind
+from stations.station import Station
+
+from .aspects import downgrade, is_open, select_aspect, stop_aspect
+from .block64d import BlockLink
+from .io import Alarm, DoorCommand, Event, Outputs, RelayBoard
+from .operations import OperatorMixin
+from .rules import RuleSet, load_rules
+from .state import RouteStage, RouteState, SignalState, TurnoutState
+from .table import InterlockingTable, Route
+
+MAX_EVENTS = 20_000
+
+
+class Interlocking(OperatorMixin):
+    """One station's interlocking, driven by ``cycle(t)`` and operator commands."""
+
+    def __init__(self, table: InterlockingTable, rules: RuleSet | None = None, cycle_s: float = 0.25) -> None:
+        self.table = table
+        self.station: Station = table.station
+        self.rules = rules or load_rules()
+        self.cycle_s = cycle_s
+        self.board = RelayBoard()
+        self.out = Outputs()
+        self.now = 0.0
+        self.cycles = 0
+        self.routes: dict[str, RouteState] = {}  # active routes in order of selection
+        self.by_signal: dict[str, str] = {}
+        self.section_lock: dict[str, str] = {}  # section -> route id
+        self.overlap_pending: dict[str, tuple[tuple[str, ...], tuple[str, ...], float | None]] = {}
+        st = self.station
+        self.turnouts = {t: TurnoutState(t, st.turnout_section[t], st.turnouts[t].trailable) for t in st.turnouts}
+        self.signals = {s.id: SignalState(s.id, stop_aspect(st, s.id)) for s in st.model.signals}
+        for s in st.model.signals:
+            self.out.set_aspect(s.id, stop_aspect(st, s.id))
+        self.links = {lk.id: BlockLink(lk.id, lk.sections[0] if lk.sections else "")
+                      for lk in st.model.links if lk.kind.value == "64d"}
+        self.auto_links = {lk.id: tuple(lk.sections) for lk in st.model.links if lk.kind.value == "automatic"}
+        self.queue: deque[str] = deque()
+        self.moving: set[str] = set()
+        self.no_indication: set[str] = set(st.turnouts)  # fail-safe: nothing reported yet
+        self.guide_locked: set[str] = set()
+        self.guide_only: dict[str, float] = {}  # guide aspect without a route (throat under guide total lock)
+        self.guide_seen: dict[str, bool] = {}
+        self.events: deque[Event] = deque(maxlen=MAX_EVENTS)
+        self.alarms: dict[str, Alarm] = {}
+        self.entry_section = {s: st.tracks[st.signal_entry_track(s)].section for s in st.signals}
+        self.signal_by_entry: dict[str, list[str]] = {}
+        for s, sec in self.entry_section.items():
+            self.signal_by_entry.setdefault(sec, []).append(s)
+        self.platform_doors = {p.section: [f"{p.id}:{d.side.value}" for d in p.screen_doors]
+                               for p in st.model.platforms if p.screen_doors}
+        self._block_signals = self._chain_block_signals()
+        self.codes_dirty = True
+        for key in (k for keys in self.platform_doors.values() for k in keys):
+            self.out.doors.setdefault(key, DoorCommand())
+
+    # ---- bookkeeping --------------------------------------------------------------------------------------------
+    def event(self, kind: str, text: str) -> None:
+        self.events.append(Event(self.now, kind, text))
+
+    def alarm(self, key: str, text: str) -> None:
+        if key not in self.alarms:
+            self.alarms[key] = Alarm(key, self.now, text)
+            self.event("alarm", text)
+
+    def clear_alarm(self, key: str) -> None:
+        self.alarms.pop(key, None)
+
+    def clear(self, section: str) -> bool:
+        return self.board.clear(section)
+
+    # ---- the cycle ------------------------------------------------------------------------------------------
+    def cycle(self, t: float) -> Outputs:
+        self.now = t
+        self.cycles += 1
+        tracks, turnouts, signals, doors, pulses = self.board.take_changes()
+        if tracks:
+            self._check_spad(tracks)
+        for link, msgs in pulses.items():
+            self._line_in(link, msgs)
+        if tracks and self.links:
+            self._line_tracks(tracks)
+        for t_id in turnouts:
+            if self.board.indication(t_id) is None:
+                if t_id not in self.no_indication:
+                    self.no_indication.add(t_id)
+                    self.turnouts[t_id].no_indication_since = self.now
+            else:
+                self.no_indication.discard(t_id)
+                ts = self.turnouts[t_id]
+                ts.no_indication_since = None
+                if ts.squeeze_alarmed:
+                    ts.squeeze_alarmed = False
+                    self.clear_alarm(f"squeeze:{t_id}")
+        self._supervise_turnouts()
+        for rs in list(self.routes.values()):
+            self._advance(rs)
+        self._guide_only()
+        self._overlaps()
+        if self._block_signals and (tracks or self.out.changed_signals):
+            self._update_block_signals()
+        if self.codes_dirty or self.out.changed_signals:
+            self._update_cab_codes()
+        del signals, doors
+        return self.out
+
+    # ---- turnouts -------------------------------------------------------------------------------------------
+    def _supervise_turnouts(self) -> None:
+        for t_id in list(self.moving):
+            ts = self.turnouts[t_id]
+            if ts.target is not None and self.board.indication(t_id) == ts.target:
+                self.moving.discard(t_id)
+                self.out.drive(t_id, None)
+                self.event("turnout", f"turnout {t_id} in {ts.target}")
+                ts.target = None
+                ts.move_started = None
+                self.clear_alarm(f"move:{t_id}")
+            elif ts.move_started is not None and self.now - ts.move_started > self.rules.turnout_timeout_s:
+                self.moving.discard(t_id)
+                self.out.drive(t_id, None)
+                self.alarm(f"move:{t_id}", f"turnout {t_id} did not reach {ts.target} within "
+                           f"{self.rules.turnout_timeout_s:g} s (no indication)")
+                ts.target = None
+                ts.move_started = None
+        while self.queue and len(self.moving) < self.rules.turnout_concurrency:
+            t_id = self.queue.popleft()
+            ts = self.turnouts[t_id]
+            ts.queued = False
+            if ts.target is None:
+                continue
+            if self.board.indication(t_id) == ts.target:
+                ts.target = None
+                continue
+            self.moving.add(t_id)
+            ts.move_started = self.now
+            self.out.drive(t_id, ts.target)
+        for t_id in self.no_indication:
+            ts = self.turnouts[t_id]
+            if t_id in self.moving or ts.queued or ts.squeeze_alarmed or not ts.trailable:
+                continue
+            since = ts.no_indication_since if ts.no_indication_since is not None else 0.0
+            if self.now - since >= self.rules.squeeze_alarm_s:
+                ts.squeeze_alarmed = True
+                self.alarm(f"squeeze:{t_id}", f"turnout {t_id} squeezed (挤岔): no indication for "
+                           f"{self.rules.squeeze_alarm_s:g} s")
+
+    def request_move(self, turnout: str, position: str) -> None:
+        """Queue a move of ``turnout`` (and its crossover partner) to ``position``."""
+        for t_id in self.pair_members(turnout):
+            ts = self.turnouts[t_id]
+            if self.board.indication(t_id) == position and t_id not in self.moving:
+                continue
+            ts.target = position
+            if t_id in self.moving:
+                ts.move_started = self.now
+                self.out.drive(t_id, position)
+            elif not ts.queued:
+                ts.queued = True
+                self.queue.append(t_id)
+
+    def pair_members(self, turnout: str) -> list[str]:
+        pair = self.station.turnouts[turnout].pair
+        return list(self.station.pairs[pair]) if pair else [turnout]
+
+    # ---- routes ---------------------------------------------------------------------------------------------
+    def _advance(self, rs: RouteState) -> None:
+        r = rs.route
+        if rs.stage is RouteStage.setting:
+            if all(self.board.indication(t.id) == t.position.value for t in r.all_turnouts):
+                rs.stage = RouteStage.locked
+                rs.since = self.now
+                self.event("route", f"route {r.id} locked")
+            else:
+                return
+        if rs.stage is RouteStage.locked:
+            if rs.entered or self._first_occupied(rs):
+                # a movement entered under a closed signal (detected as SPAD); release behind it
+                rs.entered = True
+                rs.stage = RouteStage.in_use
+            elif not rs.opened_once and not rs.needs_reopen and not rs.guide:
+                if not self.open_blocker(rs):
+                    self._open(rs)
+            return
+        if rs.stage is RouteStage.open:
+            self._keep_open(rs)
+            return
+        if rs.stage is RouteStage.time_release:
+            if any(not self.clear(s) for s in r.sections):
+                rs.stage = RouteStage.in_use
+                rs.entered = True
+                rs.release_at = None
+                self.event("route", f"time release of {r.id} abandoned: its route is occupied")
+            elif rs.release_at is not None and self.now >= rs.release_at:
+                self.event("route", f"route {r.id} released by manual time release")
+                self.finish(rs, all_sections=True)
+            return
+        if rs.stage is RouteStage.in_use:
+            self._sequential_release(rs)
+
+    def _first_occupied(self, rs: RouteState) -> bool:
+        return not self.clear(rs.route.sections[0])
+
+    def open_blocker(self, rs: RouteState, *, guide: bool = False) -> str:
+        """Why the signal of ``rs`` may not open (or stay open); '' when every condition holds."""
+        r = rs.route
+        for t in r.all_turnouts:
+            ind = self.board.indication(t.id)
+            if ind != t.position.value:
+                what = "has no indication" if ind is None else f"is {ind}"
+                return f"turnout {t.id} {what}, the route needs it {t.position.value}"
+        if not guide:
+            for s in r.all_sections:
+                if not self.clear(s):
+                    return f"section {s} is occupied"
+        blocker = self._liaison_blocker(r)
+        if blocker:
+            return blocker
+        aspect = self._wanted_aspect(rs) if not guide else "HB"
+        if not is_open(aspect):
+            return self._why_closed(rs)
+        shown = self._proven(r.signal, aspect)
+        if not is_open(shown) or (guide and shown != "HB"):
+            return f"a lamp of signal {r.signal} for {aspect} is dark"
+        return ""
+
+    def _liaison_blocker(self, r: Route) -> str:
+        if r.exit_link in self.links:
+            link = self.links[r.exit_link]
+            if link.state.value != "permitted":
+                return f"block line {link.id} has not been accepted by the neighbour station (64D: {link.state.value})"
+        if r.exit_link in self.auto_links and self._clear_blocks(r.exit_link) == 0:
+            return f"departure section {self.auto_links[r.exit_link][0]} is occupied"
+        for sec in self._door_sections(r):
+            for key in self.platform_doors[sec]:
+                if not self.board.doors_safe(key):
+                    return f"screen doors {key} are not closed and locked (and not bypassed)"
+        if r.end_signal is not None and self.signals[r.end_signal].red_dark:
+            return f"the red lamp of {r.end_signal} is dark (红灯转移): {r.signal} must stay closed"
+        return ""
+
+    def _door_sections(self, r: Route) -> list[str]:
+        out = [s for s in r.sections if s in self.platform_doors]
+        rear = self.station.signal_rear_track(r.signal)
+        if rear is not None:
+            sec = self.station.tracks[rear].section
+            if sec in self.platform_doors and sec not in out:
+                out.append(sec)
+        return out
+
+    def _clear_blocks(self, link: str) -> int:
+        n = 0
+        for s in self.auto_links[link][:3]:
+            if not self.clear(s):
+                break
+            n += 1
+        return n
+
+    def _why_closed(self, rs: RouteState) -> str:
+        r = rs.route
+        if r.category == "departure" and r.exit_link in self.auto_links:
+            return f"no clear block section beyond {r.signal}"
+        return f"signal {r.signal} has no proceed aspect for route {r.id}"
+
+    def _wanted_aspect(self, rs: RouteState) -> str:
+        r = rs.route
+        next_aspect = self.out.signals.get(r.end_signal, "") if r.end_signal else ""
+        clear_blocks = self._clear_blocks(r.exit_link) if r.exit_link in self.auto_links else None
+        usu_ready = bool(r.end_signal) and is_open(next_aspect) and self.board.flasher_ok(r.signal)
+        return select_aspect(self.station, r, next_aspect, clear_blocks, usu_ready, self.rules)
+
+    def _proven(self, signal: str, aspect: str) -> str:
+        """The aspect after lamp proving: never more permissive than ``aspect``."""
+        dark = {lamp for lamp in self.rules.lamps.get(aspect, []) if not self.board.lamp_ok(signal, lamp)}
+        if aspect == "USU" and not self.board.flasher_ok(signal):
+            dark.add("flasher")
+        if not dark:
+            return aspect
+        shown = downgrade(aspect, dark, self.rules)
+        self.alarm(f"lamp:{signal}:{aspect}", f"signal {signal}: lamp(s) {', '.join(sorted(dark))} dark for "
+                   f"{aspect}; showing {shown}")
+        return shown
+
+    def _open(self, rs: RouteState) -> None:
+        r = rs.route
+        rs.stage = RouteStage.open
+        rs.opened_once = True
+        rs.since = self.now
+        self.signals[r.signal].route = r.id
+        aspect = self._proven(r.signal, self._wanted_aspect(rs))
+        self.out.set_aspect(r.signal, aspect)
+        self.codes_dirty = True
+        self.event("signal", f"signal {r.signal} opened: {aspect} (route {r.id})")
+
+    def close_signal(self, rs: RouteState, reason: str, *, abnormal: bool) -> None:
+        r = rs.route
+        self.out.set_aspect(r.signal, stop_aspect(self.station, r.signal))
+        self.codes_dirty = True
+        rs.close_reason = reason
+        if abnormal:
+            rs.needs_reopen = True
+            rs.stage = RouteStage.locked
+            self.alarm(f"closed:{r.signal}", f"signal {r.signal} closed: {reason}")
+        else:
+            self.event("signal", f"signal {r.signal} closed: {reason}")
+
+    def _keep_open(self, rs: RouteState) -> None:
+        r = rs.route
+        if rs.guide:
+            self._keep_guide(rs)
+            return
+        if not self.clear(r.sections[0]):
+            rs.entered = True
+            if r.kind == "shunt" and any(not self.clear(s) for s in r.approach):
+                return  # a shunting signal stays open until the whole consist is past it
+            self.close_signal(rs, f"train entered {r.sections[0]}", abnormal=False)
+            rs.stage = RouteStage.in_use
+            self._sequential_release(rs)
+            return
+        blocker = self.open_blocker(rs)
+        if blocker:
+            self.close_signal(rs, blocker, abnormal=True)
+            return
+        aspect = self._proven(r.signal, self._wanted_aspect(rs))
+        if aspect != self.out.signals.get(r.signal):
+            self.out.set_aspect(r.signal, aspect)
+
+    def _keep_guide(self, rs: RouteState) -> None:
+        r = rs.route
+        for t in r.all_turnouts:
+            if self.board.indication(t.id) != t.position.value:
+                self.close_signal(rs, f"turnout {t.id} lost its indication", abnormal=True)
+                rs.guide = False
+                return
+        if not self.board.lamp_ok(r.signal, "H"):
+            self.close_signal(rs, "red lamp dark: the guide aspect needs the red lamp lit", abnormal=True)
+            rs.guide = False
+            return
+        approach_occupied = any(not self.clear(s) for s in r.approach)
+        if approach_occupied:
+            rs.guide_approach_seen = True
+        elif rs.guide_approach_seen:
+            self.close_signal(rs, "guided train has passed", abnormal=False)
+            rs.stage = RouteStage.in_use
+            rs.entered = True
+        elif self.now - rs.since > self.rules.guide_close_s:
+            self.close_signal(rs, "guide aspect not used", abnormal=False)
+            rs.guide = False
+            rs.stage = RouteStage.locked
+
+    def _sequential_release(self, rs: RouteState) -> None:
+        """Normal release with the three-point check: a section releases when the one in rear has released, this
+        one was occupied and is clear again, and the next one is occupied."""
+        r = rs.route
+        secs = r.sections
+        n = len(secs)
+        any_occupied = False
+        for i, s in enumerate(secs):
+            if not rs.released[i] and not self.clear(s):
+                rs.was_occupied[i] = True
+                any_occupied = True
+        last = n - 1
+        if (r.overlap_sections and not rs.released[last] and rs.was_occupied[last]
+                and rs.overlap_release_at is None):
+            rs.overlap_release_at = self.now + r.overlap_release_s
+        for i in range(n):
+            if rs.released[i]:
+                continue
+            if i > 0 and not rs.released[i - 1]:
+                break
+            s = secs[i]
+            if (i == last and r.category == "receiving" and self.station.is_station_track(s)
+                    and rs.was_occupied[i]):
+                self._release_section(rs, i)  # the train stands on the receiving track
+                continue
+            if not rs.was_occupied[i] or not self.clear(s):
+                break
+            nxt = secs[i + 1] if i < last else r.beyond
+            if nxt is not None and self.clear(nxt):
+                if not (r.kind == "shunt" and not any_occupied):
+                    break  # the movement has not reached the next section
+            self._release_section(rs, i)
+        if r.kind == "shunt" and not any_occupied and any(rs.released) and not all(rs.released):
+            # partial release: the shunting movement drew back out of the route
+            for i in range(n):
+                if not rs.released[i]:
+                    self._release_section(rs, i)
+        if all(rs.released):
+            self.finish(rs, all_sections=False)
+
+    def _release_section(self, rs: RouteState, i: int) -> None:
+        s = rs.route.sections[i]
+        rs.released[i] = True
+        if self.section_lock.get(s) == rs.id:
+            del self.section_lock[s]
+        for t in rs.route.turnouts:
+            if self.station.turnout_section[t.id] == s:
+                self.turnouts[t.id].locks.discard(rs.id)
+        self.event("release", f"section {s} released ({rs.id})")
+
+    def finish(self, rs: RouteState, *, all_sections: bool) -> None:
+        """Release the whole route (what is still locked), keeping a running overlap timer."""
+        r = rs.route
+        for i, s in enumerate(r.sections):
+            if not rs.released[i]:
+                rs.released[i] = True
+                if self.section_lock.get(s) == rs.id:
+                    del self.section_lock[s]
+        for f in r.fouling:
+            if self.section_lock.get(f.section) == rs.id:
+                del self.section_lock[f.section]
+        for t in r.turnouts:
+            self.turnouts[t.id].locks.discard(rs.id)
+        if r.overlap_sections:
+            if rs.overlap_release_at is not None and not all_sections:
+                self.overlap_pending[rs.id] = (r.overlap_sections, tuple(t.id for t in r.overlap_turnouts),
+                                               rs.overlap_release_at)
+            else:
+                self._release_overlap(rs.id, r.overlap_sections, tuple(t.id for t in r.overlap_turnouts))
+        if self.out.signals.get(r.signal) != stop_aspect(self.station, r.signal):
+            self.out.set_aspect(r.signal, stop_aspect(self.station, r.signal))
+        self.signals[r.signal].route = None
+        self.routes.pop(rs.id, None)
+        if self.by_signal.get(r.signal) == rs.id:
+            del self.by_signal[r.signal]
+        self.clear_alarm(f"closed:{r.signal}")
+        self.codes_dirty = True
+        self.event("route", f"route {r.id} released")
+
+    def _release_overlap(self, rid: str, sections: tuple[str, ...], turnouts: tuple[str, ...]) -> None:
+        for s in sections:
+            if self.section_lock.get(s) == f"overlap:{rid}":
+                del self.section_lock[s]
+        for t in turnouts:
+            self.turnouts[t].locks.discard(f"overlap:{rid}")
+        self.event("release", f"overlap of {rid} released")
+
+    def _overlaps(self) -> None:
+        for rid, (sections, turnouts, at) in list(self.overlap_pending.items()):
+            if at is not None and self.now >= at:
+                del self.overlap_pending[rid]
+                self._release_overlap(rid, sections, turnouts)
+
+    def _guide_only(self) -> None:
+        for sig, since in list(self.guide_only.items()):
+            approach = self.station.approach_sections(sig)
+            occupied = any(not self.clear(s) for s in approach)
+            if occupied:
+                self.guide_seen[sig] = True
+            if (not occupied and self.guide_seen.get(sig)) or (not self.guide_seen.get(sig)
+                                                               and self.now - since > self.rules.guide_close_s):
+                del self.guide_only[sig]
+                self.guide_seen.pop(sig, None)
+                self.out.set_aspect(sig, stop_aspect(self.station, sig))
+                self.event("signal", f"guide aspect of {sig} closed")
+            elif not self.board.lamp_ok(sig, "H"):
+                del self.guide_only[sig]
+                self.out.set_aspect(sig, stop_aspect(self.station, sig))
+                self.alarm(f"closed:{sig}", f"signal {sig} closed: red lamp dark, the guide aspect needs it lit")
+
+    # ---- signal passed at danger ------------------------------------------------------------------------------
+    def _check_spad(self, became: set[str]) -> None:
+        for sec in became:
+            if self.clear(sec):
+                continue
+            for sig in self.signal_by_entry.get(sec, ()):
+                if is_open(self.out.signals.get(sig, "")):
+                    continue
+                owner = self.section_lock.get(sec)
+                if owner is not None and owner in self.routes and owner != self.by_signal.get(sig):
+                    if self.routes[owner].route.direction is not self.station.signals[sig].direction:
+                        continue  # a movement from the other side, in its own route
+                rear = self.station.signal_rear_track(sig)
+                if rear is None or self.clear(self.station.tracks[rear].section):
+                    continue
+                rid = self.by_signal.get(sig)
+                self.alarm(f"spad:{sig}:{self.now:.2f}", f"signal {sig} passed at danger (冒进信号): {sec} occupied "
+                           "with the signal closed")
+                if rid is not None:
+                    rs = self.routes[rid]
+                    rs.entered = True
+                    if rs.stage in (RouteStage.time_release, RouteStage.locked):
+                        rs.stage = RouteStage.in_use
+                        rs.release_at = None
+
+    # ---- 64D ------------------------------------------------------------------------------------------------
+    def _line_in(self, link: str, msgs: set[str]) -> None:
+        bl = self.links.get(link)
+        if bl is None:
+            return
+        for m in sorted(msgs):
+            before = bl.state
+            bl.receive(m)
+            if bl.state is not before:
+                self.event("block", f"block line {link}: {m} received, {before.value} -> {bl.state.value}")
+
+    def send(self, link: str, pulse: str) -> None:
+        self.out.line_out.setdefault(link, set()).add(pulse)
+
+    def _line_tracks(self, tracks: set[str]) -> None:
+        for bl in self.links.values():
+            if bl.departure_section not in tracks:
+                continue
+            if not self.clear(bl.departure_section):
+                pulse = bl.departure_section_occupied()
+                if pulse:
+                    self.send(bl.id, pulse)
+                    self.event("block", f"block line {bl.id}: train departed, line blocked")
+            elif bl.state.value == "arriving":
+                bl.arrival_complete()
+                self.event("block", f"block line {bl.id}: train arrived complete; restore the block")
+
+    # ---- automatic block and cab codes ----------------------------------------------------------------------
+    def _chain_block_signals(self) -> list[tuple[str, tuple[str, ...], str | None]]:
+        st = self.station
+        topo = st.topology
+        out: list[tuple[str, tuple[str, ...], str | None]] = []
+        for sig in st.model.signals:
+            if sig.kind is not SignalKind.block:
+                continue
+            sections: list[str] = []
+            move = topo.start_move(sig.at, sig.direction)
+            nxt_signal = None
+            for _ in range(100):
+                sec = st.tracks[move[0]].section
+                if not sections or sections[-1] != sec:
+                    sections.append(sec)
+                far = topo.far_node(move)
+                ahead = [s for s in st.signals_at(far) if s.direction is sig.direction]
+                if ahead:
+                    nxt_signal = ahead[0].id
+                    break
+                moves = topo.next_moves(move)
+                if not moves:
+                    break
+                move = moves[0][0]
+            out.append((sig.id, tuple(sections), nxt_signal))
+        return out
+
+    def _update_block_signals(self) -> None:
+        for sig, sections, nxt in self._block_signals:
+            if any(not self.clear(s) for s in sections):
+                aspect = "H"
+            else:
+                ahead = self.out.signals.get(nxt, "L") if nxt else "L"
+                aspect = {"H": "U", "A": "U", "": "U", "U": "LU", "UU": "U"}.get(ahead, "L")
+            self.out.set_aspect(sig, self._proven(sig, aspect) if aspect != "H" else "H")
+
+    def _update_cab_codes(self) -> None:
+        self.codes_dirty = False
+        codes: dict[str, str | None] = {s.id: None for s in self.station.model.sections if s.coded}
+        for rs in self.routes.values():
+            r = rs.route
+            if r.kind != "train" or rs.stage not in (RouteStage.open, RouteStage.in_use):
+                continue
+            governing = r.end_signal if r.end_signal else r.signal
+            code = self.rules.cab_codes.get(self.out.signals.get(governing, "H"))
+            for i, s in enumerate(r.sections):
+                if s in codes and not rs.released[i]:
+                    codes[s] = code
+        self.out.cab_codes = codes

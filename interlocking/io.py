@@ -1,0 +1,151 @@
+"""The interlocking's only window on the world: relay states in, commands out (DESIGN.md principle 1).
+
+``RelayBoard`` holds the input relays the field reports (track relays GJ, turnout indication relays DBJ/FBJ, lamp
+proving relays DJ, the flasher check, platform-door relays PDKJ/PDQCJ, 64D line pulses) and remembers which changed
+since the last cycle, so a cycle does work in proportion to change. Anything the board has never been told is read
+fail-safe: a section is occupied, a turnout has no indication, a lamp is dark, doors are not proven closed.
+``Outputs`` is what the interlocking drives: turnout commands, signal aspects, door relays, cab codes, line pulses.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+
+@dataclass(frozen=True)
+class Result:
+    """The answer to an operator command: accepted, or refused with the reason in a signaller's terms."""
+
+    ok: bool
+    message: str = ""
+
+    @staticmethod
+    def accept(message: str = "") -> Result:
+        return Result(True, message)
+
+    @staticmethod
+    def refuse(message: str) -> Result:
+        return Result(False, message)
+
+
+@dataclass
+class RelayBoard:
+    track: dict[str, bool] = field(default_factory=dict)  # section -> GJ up (clear)
+    dbj: dict[str, bool] = field(default_factory=dict)  # turnout -> normal indication
+    fbj: dict[str, bool] = field(default_factory=dict)  # turnout -> reverse indication
+    lamps: dict[str, dict[str, bool]] = field(default_factory=dict)  # signal -> lamp -> DJ proven
+    flasher: dict[str, bool] = field(default_factory=dict)  # signal -> SNJ/SNJJ healthy
+    pdkj: dict[str, bool] = field(default_factory=dict)  # platform:side -> doors closed and locked
+    pdqcj: dict[str, bool] = field(default_factory=dict)  # platform:side -> interlock bypass
+    line_in: dict[str, set[str]] = field(default_factory=dict)  # link -> pulses received this cycle
+    changed_tracks: set[str] = field(default_factory=set)
+    changed_turnouts: set[str] = field(default_factory=set)
+    changed_signals: set[str] = field(default_factory=set)
+    changed_doors: set[str] = field(default_factory=set)
+
+    # ---- written by the field ----------------------------------------------------------------------------------
+    def set_track(self, section: str, clear: bool) -> None:
+        if self.track.get(section) is not clear:
+            self.track[section] = clear
+            self.changed_tracks.add(section)
+
+    def set_turnout(self, turnout: str, normal: bool, reverse: bool) -> None:
+        if self.dbj.get(turnout) is not normal or self.fbj.get(turnout) is not reverse:
+            self.dbj[turnout] = normal
+            self.fbj[turnout] = reverse
+            self.changed_turnouts.add(turnout)
+
+    def set_lamp(self, signal: str, lamp: str, proven: bool) -> None:
+        lamps = self.lamps.setdefault(signal, {})
+        if lamps.get(lamp) is not proven:
+            lamps[lamp] = proven
+            self.changed_signals.add(signal)
+
+    def set_flasher(self, signal: str, healthy: bool) -> None:
+        if self.flasher.get(signal) is not healthy:
+            self.flasher[signal] = healthy
+            self.changed_signals.add(signal)
+
+    def set_doors(self, key: str, closed_locked: bool, bypass: bool) -> None:
+        if self.pdkj.get(key) is not closed_locked or self.pdqcj.get(key) is not bypass:
+            self.pdkj[key] = closed_locked
+            self.pdqcj[key] = bypass
+            self.changed_doors.add(key)
+
+    def pulse(self, link: str, message: str) -> None:
+        self.line_in.setdefault(link, set()).add(message)
+
+    # ---- read by the interlocking (fail-safe defaults) ------------------------------------------------------
+    def clear(self, section: str) -> bool:
+        return self.track.get(section, False)
+
+    def indication(self, turnout: str) -> str | None:
+        n, r = self.dbj.get(turnout, False), self.fbj.get(turnout, False)
+        if n and not r:
+            return "normal"
+        if r and not n:
+            return "reverse"
+        return None
+
+    def lamp_ok(self, signal: str, lamp: str) -> bool:
+        return self.lamps.get(signal, {}).get(lamp, False)
+
+    def flasher_ok(self, signal: str) -> bool:
+        return self.flasher.get(signal, False)
+
+    def doors_safe(self, key: str) -> bool:
+        return self.pdkj.get(key, False) or self.pdqcj.get(key, False)
+
+    def take_changes(self) -> tuple[set[str], set[str], set[str], set[str], dict[str, set[str]]]:
+        out = (self.changed_tracks, self.changed_turnouts, self.changed_signals, self.changed_doors, self.line_in)
+        self.changed_tracks, self.changed_turnouts, self.changed_signals = set(), set(), set()
+        self.changed_doors, self.line_in = set(), {}
+        return out
+
+
+@dataclass
+class DoorCommand:
+    """Relays the interlocking drives for one platform side (DOMAIN.md section 5)."""
+
+    zckj: bool = False  # platform track occupied / authorised
+    kmj: bool = False  # open command
+    gmj: bool = True  # close command
+
+
+@dataclass
+class Outputs:
+    turnouts: dict[str, str] = field(default_factory=dict)  # turnout -> position being driven to
+    signals: dict[str, str] = field(default_factory=dict)  # signal -> commanded aspect
+    doors: dict[str, DoorCommand] = field(default_factory=dict)  # platform:side -> relays
+    cab_codes: dict[str, str | None] = field(default_factory=dict)  # coded section -> low-frequency code
+    line_out: dict[str, set[str]] = field(default_factory=dict)  # link -> pulses sent this cycle
+    changed_signals: set[str] = field(default_factory=set)
+    changed_turnouts: set[str] = field(default_factory=set)
+
+    def set_aspect(self, signal: str, aspect: str) -> None:
+        if self.signals.get(signal) != aspect:
+            self.signals[signal] = aspect
+            self.changed_signals.add(signal)
+
+    def drive(self, turnout: str, position: str | None) -> None:
+        if position is None:
+            if self.turnouts.pop(turnout, None) is not None:
+                self.changed_turnouts.add(turnout)
+        elif self.turnouts.get(turnout) != position:
+            self.turnouts[turnout] = position
+            self.changed_turnouts.add(turnout)
+
+
+@dataclass(frozen=True)
+class Event:
+    t: float
+    kind: str
+    text: str
+
+
+@dataclass
+class Alarm:
+    key: str
+    t: float
+    text: str
+    acknowledged: bool = False

@@ -1,0 +1,231 @@
+"""The command language shared by the console, scripts, scenarios and the API (DESIGN.md).
+
+Each command returns a :class:`Result`; a refusal (or a failed ``expect``) says why.
+"""
+
+from __future__ import annotations
+
+import shlex
+from collections.abc import Callable
+from typing import TYPE_CHECKING
+
+from interlocking.io import Result
+from interlocking.table import Kind
+
+from .timeparse import parse_duration
+
+if TYPE_CHECKING:
+    from .sim import Simulation
+
+Handler = Callable[["Simulation", list[str]], Result]
+
+USAGE = {
+    "route": "route START END [VIA ...]",
+    "shunt": "shunt START END [VIA ...]",
+    "cancel": "cancel SIGNAL",
+    "release": "release SIGNAL",
+    "fault-release": "fault-release SECTION",
+    "reopen": "reopen SIGNAL",
+    "guide": "guide SIGNAL",
+    "guide-lock": "guide-lock THROAT",
+    "guide-unlock": "guide-unlock THROAT",
+    "throw": "throw TURNOUT normal|reverse",
+    "lock": "lock TURNOUT",
+    "unlock": "unlock TURNOUT",
+    "block": "block TURNOUT",
+    "unblock": "unblock TURNOUT",
+    "block-line": "block-line LINK request|accept|cancel|restore|accident",
+    "neighbour": "neighbour LINK request|depart|restore|accident",
+    "doors": "doors PLATFORM open|close",
+    "occupy": "occupy SECTION",
+    "vacate": "vacate SECTION",
+    "run": "run DURATION",
+    "expect": "expect signal|route|turnout|section|refused|accepted|alarm|no-alarm ...",
+}
+
+
+def _route(kind: Kind) -> Handler:
+    def handler(sim: Simulation, args: list[str]) -> Result:
+        if len(args) < 2:
+            return Result.refuse(f"usage: {USAGE['route' if kind == 'train' else 'shunt']}")
+        return sim.interlocking.set_route(kind, args[0], args[-1], tuple(args[1:-1]))
+
+    return handler
+
+
+def _one(name: str, fn: Callable[[Simulation, str], Result]) -> Handler:
+    def handler(sim: Simulation, args: list[str]) -> Result:
+        if len(args) != 1:
+            return Result.refuse(f"usage: {USAGE[name]}")
+        return fn(sim, args[0])
+
+    return handler
+
+
+def _throw(sim: Simulation, args: list[str]) -> Result:
+    if len(args) != 2:
+        return Result.refuse(f"usage: {USAGE['throw']}")
+    return sim.interlocking.throw(args[0], args[1])
+
+
+def _section(sim: Simulation, name: str) -> str:
+    return "" if name in sim.station.sections else f"there is no section '{name}' at {sim.station.id}"
+
+
+def _occupy(sim: Simulation, section: str) -> Result:
+    why = _section(sim, section)
+    if why:
+        return Result.refuse(why)
+    sim.field.occupy(section)
+    return Result.accept(f"{section} occupied")
+
+
+def _vacate(sim: Simulation, section: str) -> Result:
+    why = _section(sim, section)
+    if why:
+        return Result.refuse(why)
+    sim.field.vacate(section)
+    return Result.accept(f"{section} vacated")
+
+
+def _run(sim: Simulation, args: list[str]) -> Result:
+    if len(args) != 1:
+        return Result.refuse(f"usage: {USAGE['run']}")
+    try:
+        seconds = parse_duration(args[0])
+    except ValueError as exc:
+        return Result.refuse(str(exc))
+    if seconds > 7 * 24 * 3600:
+        return Result.refuse("run at most a week of simulated time in one command")
+    sim.run(seconds)
+    return Result.accept(f"t = {sim.t:g} s")
+
+
+def _block_line(sim: Simulation, args: list[str]) -> Result:
+    if len(args) != 2:
+        return Result.refuse(f"usage: {USAGE['block-line']}")
+    return sim.interlocking.block_line(args[0], args[1])
+
+
+def _neighbour(sim: Simulation, args: list[str]) -> Result:
+    if len(args) != 2:
+        return Result.refuse(f"usage: {USAGE['neighbour']}")
+    link, action = args
+    if link not in sim.field.neighbours:
+        return Result.refuse(f"there is no virtual neighbour on block line '{link}'")
+    if action not in ("request", "depart", "restore", "accident"):
+        return Result.refuse(f"usage: {USAGE['neighbour']}")
+    sim.field.neighbour_sends(link, action)
+    return Result.accept(f"neighbour on {link}: {action}")
+
+
+def _doors(sim: Simulation, args: list[str]) -> Result:
+    if len(args) != 2:
+        return Result.refuse(f"usage: {USAGE['doors']}")
+    return sim.interlocking.doors(args[0], args[1])
+
+
+# ---- expect ----------------------------------------------------------------------------------------------------
+def _expect(sim: Simulation, args: list[str]) -> Result:
+    if not args:
+        return Result.refuse(f"usage: {USAGE['expect']}")
+    what, rest = args[0], args[1:]
+    il = sim.interlocking
+    st = sim.station
+    if what == "signal" and len(rest) == 2:
+        sig, want = rest
+        if sig not in st.signals:
+            return Result.refuse(f"there is no signal '{sig}'")
+        got = sim.aspect(sig)
+        return Result(got == want, f"signal {sig} shows {got}" + ("" if got == want else f", expected {want}"))
+    if what == "route" and len(rest) in (2, 3):
+        if len(rest) == 2:
+            route_id, want = rest
+        else:
+            route_id, want = f"{rest[0]}-{rest[1]}", rest[2]
+        if route_id not in sim.table.routes and not any(r.startswith(route_id + "(") for r in sim.table.routes):
+            return Result.refuse(f"there is no route {route_id}")
+        got = sim.route_state(route_id)
+        ok = got == want or (want == "locked" and got in ("locked", "open", "in_use", "time_release"))
+        return Result(ok, f"route {route_id} is {got}" + ("" if ok else f", expected {want}"))
+    if what == "turnout" and len(rest) in (2, 3):
+        t, want = rest[0], rest[1]
+        if t not in st.turnouts:
+            return Result.refuse(f"there is no turnout '{t}'")
+        pos, locked = sim.turnout_state(t)
+        ok = pos == want and (len(rest) == 2 or (rest[2] == "locked") == locked)
+        state = f"turnout {t} is {pos or 'without indication'}{' and locked' if locked else ''}"
+        return Result(ok, state + ("" if ok else f", expected {' '.join(rest[1:])}"))
+    if what == "section" and len(rest) == 2:
+        s, want = rest
+        if s not in st.sections:
+            return Result.refuse(f"there is no section '{s}'")
+        got = sim.section_state(s)
+        return Result(got == want, f"section {s} is {got}" + ("" if got == want else f", expected {want}"))
+    if what in ("refused", "accepted"):
+        last = sim.last_result
+        text = " ".join(rest)
+        if last is None:
+            return Result.refuse("no command before this expect")
+        if what == "refused":
+            ok = not last.ok and text.lower() in last.message.lower()
+            return Result(ok, f"the command was {'refused' if not last.ok else 'accepted'}: {last.message}")
+        ok = last.ok and text.lower() in last.message.lower()
+        return Result(ok, f"the command was {'accepted' if last.ok else 'refused'}: {last.message}")
+    if what in ("alarm", "no-alarm"):
+        text = " ".join(rest).lower()
+        hits = [a for a in sim.alarm_texts() if text in a.lower()]
+        ok = bool(hits) if what == "alarm" else not hits
+        shown = "; ".join(sim.alarm_texts()) or "none"
+        return Result(ok, f"active alarms: {shown}")
+    if what == "block-line" and len(rest) == 2:
+        bl = il.links.get(rest[0])
+        if bl is None:
+            return Result.refuse(f"there is no 64D block line '{rest[0]}'")
+        return Result(bl.state.value == rest[1], f"block line {rest[0]} is {bl.state.value}")
+    if what == "code" and len(rest) == 2:
+        s, want = rest
+        got = il.out.cab_codes.get(s)
+        shown = got or "none"
+        return Result(shown == want, f"section {s} carries code {shown}" + ("" if shown == want else
+                                                                              f", expected {want}"))
+    return Result.refuse(f"usage: {USAGE['expect']}")
+
+
+COMMANDS: dict[str, Handler] = {
+    "route": _route("train"),
+    "shunt": _route("shunt"),
+    "cancel": _one("cancel", lambda s, a: s.interlocking.cancel(a)),
+    "release": _one("release", lambda s, a: s.interlocking.release(a)),
+    "fault-release": _one("fault-release", lambda s, a: s.interlocking.fault_release(a)),
+    "reopen": _one("reopen", lambda s, a: s.interlocking.reopen(a)),
+    "guide": _one("guide", lambda s, a: s.interlocking.guide(a)),
+    "guide-lock": _one("guide-lock", lambda s, a: s.interlocking.guide_lock(a, True)),
+    "guide-unlock": _one("guide-unlock", lambda s, a: s.interlocking.guide_lock(a, False)),
+    "throw": _throw,
+    "lock": _one("lock", lambda s, a: s.interlocking.single_lock(a, True)),
+    "unlock": _one("unlock", lambda s, a: s.interlocking.single_lock(a, False)),
+    "block": _one("block", lambda s, a: s.interlocking.single_block(a, True)),
+    "unblock": _one("unblock", lambda s, a: s.interlocking.single_block(a, False)),
+    "block-line": _block_line,
+    "neighbour": _neighbour,
+    "doors": _doors,
+    "occupy": _one("occupy", _occupy),
+    "vacate": _one("vacate", _vacate),
+    "run": _run,
+    "expect": _expect,
+}
+
+
+def execute(sim: Simulation, line: str) -> Result:
+    text = line.split("#", 1)[0].strip()
+    if not text:
+        return Result.accept("")
+    try:
+        words = shlex.split(text)
+    except ValueError as exc:
+        return Result.refuse(f"cannot read the command: {exc}")
+    handler = COMMANDS.get(words[0])
+    if handler is None:
+        return Result.refuse(f"unknown command '{words[0]}'; commands: {', '.join(sorted(COMMANDS))}")
+    return handler(sim, words[1:])
