@@ -133,9 +133,10 @@ class _Builder:
         for s in self.st.signals_at(node):
             if s.direction is d and Button.train in s.buttons:
                 return s.id, "signal"
-        for s in self.st.signals_at(node):
-            if s.direction is not d and s.kind is SignalKind.home:
-                return s.id, "exit"
+        if self.st.model.line == "single":  # a single line is worked both ways: the opposite home signal is the exit
+            for s in self.st.signals_at(node):
+                if s.direction is not d and s.kind is SignalKind.home:
+                    return s.id, "exit"
         for b in self.st.model.buttons:
             if b.at == node and b.kind == "exit" and (b.direction is None or b.direction is d):
                 return b.id, "exit"
@@ -338,7 +339,7 @@ class _Builder:
         if ov is not None:
             ov_sections = tuple(ov.sections)  # type: ignore[attr-defined]
             ov_turnouts = tuple(RouteTurnout(t.turnout, t.position, "route")
-                                for t in (ov.turnouts or []))  # type: ignore[attr-defined]
+                                for t in ov.turnouts)  # type: ignore[attr-defined]
             ov_release = float(ov.release_s)  # type: ignore[attr-defined]
         routes[rid] = Route(
             id=rid, kind=kind, category=category, start=start, end=end, via=via, signal=start,

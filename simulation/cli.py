@@ -54,6 +54,52 @@ def cmd_schema(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_table(args: argparse.Namespace) -> int:
+    from interlocking.table import build_table
+    from interlocking.tableformat import as_csv, as_json, as_text
+
+    try:
+        table = build_table(load(args.station))
+    except StationError as exc:
+        return _print_errors(exc)
+    print({"text": as_text, "csv": as_csv, "json": as_json}[args.format](table), end="" if args.format == "csv"
+          else "\n")
+    return 0
+
+
+def cmd_test(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from .scripts import Outcome, parse_script, run_script
+
+    outcomes: list[Outcome] = []
+    broken = 0
+    for f in args.files:
+        try:
+            script = parse_script(Path(f))
+            outcomes += run_script(script, args.k)
+        except StationError as exc:
+            for d in exc.diagnostics:
+                print(d, file=sys.stderr)
+            broken += 1
+    for o in outcomes:
+        if o.passed:
+            print(f"PASS {o.script}: {o.name}")
+        else:
+            print(f"FAIL {o.script}:{o.line}: {o.name}\n    {o.failure}")
+            if args.verbose:
+                for entry in o.log:
+                    print(f"      {entry}")
+    if args.junit_xml:
+        from .junit import write_junit
+
+        write_junit(args.junit_xml, outcomes)
+    passed = sum(o.passed for o in outcomes)
+    failed = len(outcomes) - passed + broken
+    print(f"{passed} passed, {failed} failed")
+    return 0 if failed == 0 and outcomes else 1
+
+
 def cmd_run_default(args: argparse.Namespace) -> int:
     """Headless stand-in for the console until it exists: load the default station and print its state."""
     try:
@@ -78,6 +124,14 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("station", help="bundled station name or path to a station YAML file")
     sp.add_argument("--format", choices=("text", "json"), default="text")
     add("schema", cmd_schema, "print the JSON Schema of the station format")
+    sp = add("table", cmd_table, "print the interlocking table (联锁表) derived from the topology")
+    sp.add_argument("station", help="bundled station name or path")
+    sp.add_argument("--format", choices=("text", "csv", "json"), default="text")
+    sp = add("test", cmd_test, "run YAML route-test scripts")
+    sp.add_argument("files", nargs="+", help="test script files")
+    sp.add_argument("-k", metavar="TEXT", help="run only tests whose name contains TEXT")
+    sp.add_argument("-v", "--verbose", action="store_true", help="print every step of failing tests")
+    sp.add_argument("--junit-xml", metavar="FILE", help="also write a JUnit XML report")
     add("run-default", cmd_run_default, "load the default station headless and print its state")
     return p
 

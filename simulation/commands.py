@@ -40,7 +40,7 @@ USAGE = {
     "occupy": "occupy SECTION",
     "vacate": "vacate SECTION",
     "run": "run DURATION",
-    "expect": "expect signal|route|turnout|section|refused|accepted|alarm|no-alarm ...",
+    "expect": "expect signal|route|turnout|section|refused|accepted|alarm|no-alarm|block-line|code ...",
 }
 
 
@@ -153,7 +153,7 @@ def _expect(sim: Simulation, args: list[str]) -> Result:
         if t not in st.turnouts:
             return Result.refuse(f"there is no turnout '{t}'")
         pos, locked = sim.turnout_state(t)
-        ok = pos == want and (len(rest) == 2 or (rest[2] == "locked") == locked)
+        ok = (pos or "none") == want and (len(rest) == 2 or (rest[2] == "locked") == locked)
         state = f"turnout {t} is {pos or 'without indication'}{' and locked' if locked else ''}"
         return Result(ok, state + ("" if ok else f", expected {' '.join(rest[1:])}"))
     if what == "section" and len(rest) == 2:

@@ -49,6 +49,31 @@ class IdealField:
         self._dirty_doors: set[str] = set(self.doors_open)
         self._lamps_published = False
         self.t = 0.0
+        # equipment states the fault models of the circuits layer will drive; kept minimal here
+        self.indication_lost: set[str] = set()  # turnouts whose indication circuit is broken
+        self.jammed: set[str] = set()  # machines that run but never reach the end position
+        self.dark: set[tuple[str, str]] = set()  # (signal, lamp) with both filaments broken
+        self.flasher_failed: set[str] = set()
+        self.doors_stuck: set[str] = set()  # doors that do not move whatever the command
+
+    def set_indication_lost(self, turnout: str, lost: bool) -> None:
+        (self.indication_lost.add if lost else self.indication_lost.discard)(turnout)
+        self._dirty_turnouts.add(turnout)
+
+    def set_lamp_dark(self, signal: str, lamp: str, dark: bool) -> None:
+        (self.dark.add if dark else self.dark.discard)((signal, lamp))
+        self._lamps_published = False
+
+    def set_flasher_failed(self, signal: str, failed: bool) -> None:
+        (self.flasher_failed.add if failed else self.flasher_failed.discard)(signal)
+        self._lamps_published = False
+
+    def set_doors(self, key: str, *, open_: bool | None = None, bypass: bool | None = None) -> None:
+        if open_ is not None:
+            self.doors_open[key] = open_
+        if bypass is not None:
+            self.bypass[key] = bypass
+        self._dirty_doors.add(key)
 
     # ---- instructor / script actions -------------------------------------------------------------------------
     def occupy(self, section: str) -> None:
@@ -73,12 +98,14 @@ class IdealField:
                 m.position = None
                 self._dirty_turnouts.add(t_id)
         for t_id, m in self.machines.items():
-            if m.target is not None:
+            if m.target is not None and t_id not in self.jammed:
                 m.remaining -= dt
                 if m.remaining <= 1e-9:
                     m.position, m.target = m.target, None
                     self._dirty_turnouts.add(t_id)
         for key, cmd in out.doors.items():
+            if key in self.doors_stuck:
+                continue
             want_open = cmd.kmj and cmd.zckj and not cmd.gmj
             if cmd.gmj:
                 want_open = False
@@ -106,7 +133,7 @@ class IdealField:
             board.set_track(s, s not in self.occupied)
         self._dirty_tracks.clear()
         for t_id in self._dirty_turnouts:
-            pos = self.machines[t_id].position
+            pos = None if t_id in self.indication_lost else self.machines[t_id].position
             board.set_turnout(t_id, pos == "normal", pos == "reverse")
         self._dirty_turnouts.clear()
         for key in self._dirty_doors:
@@ -115,8 +142,8 @@ class IdealField:
         if not self._lamps_published:
             for sig in self.station.model.signals:
                 for lamp in sig.lamps:
-                    board.set_lamp(sig.id, lamp.value, True)
-                board.set_flasher(sig.id, True)
+                    board.set_lamp(sig.id, lamp.value, (sig.id, lamp.value) not in self.dark)
+                board.set_flasher(sig.id, sig.id not in self.flasher_failed)
             self._lamps_published = True
         for link, nb in self.neighbours.items():
             due = [p for at, p in nb.outbox if at <= self.t]

@@ -10,7 +10,7 @@ from pathlib import Path
 
 from interlocking.engine import Interlocking
 from interlocking.io import Result
-from interlocking.rules import load_rules
+from interlocking.rules import RuleSet, load_rules
 from interlocking.state import RouteStage
 from interlocking.table import InterlockingTable, build_table
 from stations.loader import load
@@ -20,10 +20,10 @@ from .field import IdealField
 
 
 class Simulation:
-    def __init__(self, station: str | Path | Station, *, cycle_s: float = 0.25, rules: str = "china",
+    def __init__(self, station: str | Path | Station, *, cycle_s: float = 0.25, rules: str | RuleSet = "china",
                  table: InterlockingTable | None = None) -> None:
         self.station = station if isinstance(station, Station) else load(station)
-        self.rules = load_rules(rules)
+        self.rules = load_rules(rules) if isinstance(rules, str) else rules
         self.table = table or build_table(self.station)
         self.cycle_s = cycle_s
         self.interlocking = Interlocking(self.table, self.rules, cycle_s)
@@ -49,7 +49,10 @@ class Simulation:
         """Run one line of the command language; scripts' ``expect`` lines check the state."""
         from .commands import execute
 
+        self.field.publish(self.interlocking.board)
         result = execute(self, line)
+        # relays follow the field at once; only the interlocking's processing is cyclic
+        self.field.publish(self.interlocking.board)
         if not line.strip().startswith("expect"):
             self.last_result = result
         return result

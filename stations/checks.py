@@ -94,7 +94,8 @@ class _Checker:
                     self.err(("tracks", i, key), f"track '{t.id}' {key} '{ref}' is not an end, joint or turnout leg",
                              "declare it under 'ends:', 'joints:' or 'turnouts:', or fix the spelling")
             if t.start == t.end:
-                self.err(("tracks", i, "to"), f"track '{t.id}' starts and ends at the same place", "")
+                self.err(("tracks", i, "to"), f"track '{t.id}' starts and ends at the same place",
+                         "a track runs between two different nodes; check 'from' and 'to'")
 
     def _track_ports(self) -> Iterator[tuple[int, str, Port, Port]]:
         for i, t in enumerate(self.m.tracks):
@@ -185,7 +186,8 @@ class _Checker:
                          "e.g. 'capacitors: {rule: standard}'")
             if caps is not None and s.type is not CircuitType.zpw2000a:
                 self.err(("sections", k, "capacitors"),
-                         f"section '{s.id}': compensation capacitors belong to ZPW-2000A sections", "")
+                         f"section '{s.id}': compensation capacitors belong to ZPW-2000A sections",
+                         "remove 'capacitors', or make the section 'type: zpw2000a'")
         if self.errors:
             return
         # sections are bounded by joints or ends: tracks meeting at a turnout share a section, tracks meeting at a
@@ -288,14 +290,19 @@ class _Checker:
                 self.err(("signals", k, "usu"), f"signal {s.id} may show USU but lacks a U or U2 lamp",
                          "USU needs the yellow (U) and second yellow (U2) lamps")
             if s.usu and s.kind not in (SignalKind.home, SignalKind.route):
-                self.err(("signals", k, "usu"), f"only home and route signals show USU, not {s.kind.value} {s.id}", "")
+                self.err(("signals", k, "usu"), f"only home and route signals show USU, not {s.kind.value} {s.id}",
+                         "remove 'usu: true'")
             if Button.train in s.buttons and s.kind in (SignalKind.shunting, SignalKind.block):
-                self.err(("signals", k, "buttons"), f"{s.kind.value} signal {s.id} cannot have a train button", "")
+                self.err(("signals", k, "buttons"), f"{s.kind.value} signal {s.id} cannot have a train button",
+                         "train buttons belong to home, starting and route signals; a shunting signal takes "
+                         "'buttons: [shunt]'")
             if s.kind is SignalKind.shunting and Button.shunt not in s.buttons and s.buttons:
-                self.err(("signals", k, "buttons"), f"shunting signal {s.id} needs a shunt button", "")
+                self.err(("signals", k, "buttons"), f"shunting signal {s.id} needs a shunt button",
+                         "write 'buttons: [shunt]'")
             for m, sec in enumerate(s.approach or []):
                 if sec not in {x.id for x in self.m.sections}:
-                    self.err(("signals", k, "approach", m), f"signal {s.id}: approach section '{sec}' not declared", "")
+                    self.err(("signals", k, "approach", m), f"signal {s.id}: approach section '{sec}' not declared",
+                             "name a section listed under 'sections:'")
 
     def standalone_buttons(self) -> None:
         nodes = {j.id for j in self.m.joints} | {e.id for e in self.m.ends}
@@ -304,13 +311,15 @@ class _Checker:
             ok = b.at in tracks if b.kind == "variant" else b.at in nodes
             if not ok:
                 where = "a track" if b.kind == "variant" else "a joint or an end"
-                self.err(("buttons", k, "at"), f"button {b.id} ({b.kind}) is at '{b.at}', which is not {where}", "")
+                self.err(("buttons", k, "at"), f"button {b.id} ({b.kind}) is at '{b.at}', which is not {where}",
+                         "variant buttons stand on a track; exit and end buttons at a joint or an end")
 
     def fouling_points(self) -> None:
         tracks = {t.id: t for t in self.m.tracks}
         for k, f in enumerate(self.m.fouling_points):
             if f.track not in tracks:
-                self.err(("fouling_points", k, "track"), f"fouling point {f.id} is on unknown track '{f.track}'", "")
+                self.err(("fouling_points", k, "track"), f"fouling point {f.id} is on unknown track '{f.track}'",
+                         "name a track id listed under 'tracks:'")
                 continue
             t = tracks[f.track]
             xa = self.node_positions[parse_port(t.start).node]
@@ -325,14 +334,16 @@ class _Checker:
         for k, p in enumerate(self.m.platforms):
             s = sections.get(p.section)
             if s is None:
-                self.err(("platforms", k, "section"), f"platform {p.id} is at unknown section '{p.section}'", "")
+                self.err(("platforms", k, "section"), f"platform {p.id} is at unknown section '{p.section}'",
+                         "name a station-track section listed under 'sections:'")
             elif s.role is not SectionRole.station_track:
                 self.err(("platforms", k, "section"),
                          f"platform {p.id} is at section '{p.section}', which is not a station track",
                          "platforms and their screen doors stand at station tracks ('role: station_track')")
             sides = [d.side for d in p.screen_doors]
             if len(sides) != len(set(sides)):
-                self.err(("platforms", k, "screen_doors"), f"platform {p.id} lists a side twice", "")
+                self.err(("platforms", k, "screen_doors"), f"platform {p.id} lists a side twice",
+                         "give each side (left, right) at most once")
 
     def links(self) -> None:
         ends = {e.id: e for e in self.m.ends}
@@ -344,7 +355,8 @@ class _Checker:
                          "block links leave the station at an end of 'kind: boundary'")
             for m, sec in enumerate(lk.sections):
                 if sec not in sections:
-                    self.err(("links", k, "sections", m), f"link {lk.id}: section '{sec}' is not declared", "")
+                    self.err(("links", k, "sections", m), f"link {lk.id}: section '{sec}' is not declared",
+                             "name a section listed under 'sections:'")
 
     def overlaps_and_overrides(self) -> None:
         signals = {s.id for s in self.m.signals}
@@ -352,17 +364,21 @@ class _Checker:
         turnouts = {t.id for t in self.m.turnouts}
         for k, o in enumerate(self.m.overlaps):
             if o.end_signal not in signals:
-                self.err(("overlaps", k, "end_signal"), f"overlap at unknown signal '{o.end_signal}'", "")
+                self.err(("overlaps", k, "end_signal"), f"overlap at unknown signal '{o.end_signal}'",
+                         "name the signal at the end of the receiving route, as listed under 'signals:'")
             for m, sec in enumerate(o.sections):
                 if sec not in sections:
-                    self.err(("overlaps", k, "sections", m), f"overlap section '{sec}' is not declared", "")
-            for m, t in enumerate(o.turnouts or []):
+                    self.err(("overlaps", k, "sections", m), f"overlap section '{sec}' is not declared",
+                             "name a section listed under 'sections:'")
+            for m, t in enumerate(o.turnouts):
                 if t.turnout not in turnouts:
-                    self.err(("overlaps", k, "turnouts", m), f"overlap turnout '{t.turnout}' is not declared", "")
+                    self.err(("overlaps", k, "turnouts", m), f"overlap turnout '{t.turnout}' is not declared",
+                             "name a turnout listed under 'turnouts:'")
         for key in ("protection", "remove_protection"):
             for m, p in enumerate(getattr(self.m.overrides, key)):
                 if p.turnout not in turnouts:
-                    self.err(("overrides", key, m, "turnout"), f"override names unknown turnout '{p.turnout}'", "")
+                    self.err(("overrides", key, m, "turnout"), f"override names unknown turnout '{p.turnout}'",
+                             "name a turnout listed under 'turnouts:'")
 
     def connected(self) -> None:
         g = nx.Graph()

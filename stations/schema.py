@@ -11,7 +11,7 @@ import re
 from enum import StrEnum
 from typing import Annotated, Literal
 
-from pydantic import AfterValidator, BaseModel, BeforeValidator, ConfigDict, Field
+from pydantic import AfterValidator, BaseModel, BeforeValidator, ConfigDict, Field, WithJsonSchema
 
 _ID_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_\-/]*$")
 _KM_RE = re.compile(r"^K(\d+)\+(\d+(?:\.\d+)?)$")
@@ -32,7 +32,9 @@ def _check_id(value: str) -> str:
     return value
 
 
-Id = Annotated[str, BeforeValidator(_to_id), AfterValidator(_check_id)]
+# JSON Schema: what the loader accepts (a whole number such as turnout 1 is taken as the id '1').
+_ID_SCHEMA = {"anyOf": [{"type": "string", "pattern": _ID_RE.pattern}, {"type": "integer", "minimum": 0}]}
+Id = Annotated[str, BeforeValidator(_to_id), AfterValidator(_check_id), WithJsonSchema(_ID_SCHEMA)]
 
 
 def parse_km(text: str) -> float:
@@ -54,12 +56,14 @@ def _position(value: object) -> object:
 
 
 # A position: metres along the line, or a kilometre post ``K12+345.6``.
-Position = Annotated[float, BeforeValidator(_position)]
+Position = Annotated[float, BeforeValidator(_position), WithJsonSchema(
+    {"anyOf": [{"type": "number"}, {"type": "string", "pattern": _KM_RE.pattern}],
+     "description": "metres (down direction increasing) or a kilometre post such as K12+345.6"})]
 Metres = Annotated[float, Field(gt=0), BeforeValidator(lambda v: float(v) if type(v) is int else v)]
 
 
 class Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", strict=True, frozen=True)
+    model_config = ConfigDict(extra="forbid", strict=True, frozen=True, allow_inf_nan=False)
 
 
 class Direction(StrEnum):
@@ -146,7 +150,8 @@ class Track(Strict):
     length: Metres | None = None
     row: float | None = None  # schematic row, 0 = the main line
 
-    model_config = ConfigDict(extra="forbid", strict=True, frozen=True, populate_by_name=True)
+    model_config = ConfigDict(extra="forbid", strict=True, frozen=True, populate_by_name=True,
+                              allow_inf_nan=False)
 
 
 class CircuitType(StrEnum):
@@ -183,7 +188,8 @@ def _check_carrier(value: str) -> str:
     return value
 
 
-Carrier = Annotated[str, BeforeValidator(_to_id), AfterValidator(_check_carrier)]
+Carrier = Annotated[str, BeforeValidator(_to_id), AfterValidator(_check_carrier),
+                    WithJsonSchema({"type": "string", "pattern": _CARRIER_RE.pattern})]
 
 
 class Section(Strict):
@@ -308,12 +314,19 @@ class Overrides(Strict):
     forbid: list[Id] = Field(default_factory=list)
 
 
+class TurnoutAt(Strict):
+    turnout: Id
+    position: TurnoutPosition
+
+
 class Overlap(Strict):
-    """An overlap (延续进路) beyond the end signal of receiving routes, where the file asks for one."""
+    """An overlap (延续进路) beyond the end signal of receiving routes, where the file asks for one (e.g. a falling
+    gradient over 6 per mille beyond the track): its sections and turnouts are locked with the route and released
+    ``release_s`` after the train occupies the receiving track."""
 
     end_signal: Id
     sections: list[Id] = Field(min_length=1)
-    turnouts: list[ProtectionOverride] | None = None
+    turnouts: list[TurnoutAt] = Field(default_factory=list)
     release_s: Annotated[float, Field(gt=0)] = 180.0
 
 

@@ -86,6 +86,8 @@ class Topology:
         shorter than ``max_length``."""
         stop_at = stop_at or set()
         first = self.start_move(node, direction)
+        if self.near_node(first) != node:
+            return  # e.g. from a boundary outwards: there is no track that way
         stack: list[tuple[list[Move], list[tuple[str, TurnoutPosition]], list[str], float]] = [
             ([first], [], [], self.station.track_length(first[0]))
         ]

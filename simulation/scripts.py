@@ -1,0 +1,149 @@
+"""YAML route-test scripts (``liansuo test``).
+
+```yaml
+station: jiaopei
+tests:
+  - name: receiving route onto the main track
+    steps:
+      - route X XI
+      - run 15s
+      - expect signal X U
+```
+Each test runs on a fresh simulation. A command that is refused fails the test unless the next step is
+``expect refused ...``. A failing step prints the step, what was expected and what the state was.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from stations.loader import load
+from stations.source import Diagnostic, Source, StationError, read_file
+from stations.station import Station
+
+from .commands import COMMANDS
+from .sim import Simulation
+
+
+@dataclass
+class Step:
+    text: str
+    line: int
+
+
+@dataclass
+class ScriptTest:
+    name: str
+    steps: list[Step]
+    line: int
+
+
+@dataclass
+class Script:
+    file: str
+    station: str
+    tests: list[ScriptTest]
+    cycle_s: float = 0.25
+
+
+@dataclass
+class Outcome:
+    script: str
+    name: str
+    passed: bool
+    failure: str = ""
+    line: int = 0
+    log: list[str] = field(default_factory=list)
+
+
+def parse_script(path: Path) -> Script:
+    src = read_file(path)
+    errors: list[Diagnostic] = []
+    data = src.data
+    if not isinstance(data, dict):
+        raise StationError([src.diagnostic((), "a test script is a mapping with 'station:' and 'tests:'",
+                                           "see examples/ for scripts")])
+    for key in data:
+        if key not in ("station", "tests", "cycle_ms"):
+            errors.append(src.diagnostic((key,), f"unknown key '{key}'", "a script has station, tests and "
+                                         "optionally cycle_ms", at_key=True))
+    station = data.get("station")
+    if not isinstance(station, str):
+        errors.append(src.diagnostic(("station",) if "station" in data else (), "missing or invalid 'station:'",
+                                     "name a bundled station or a station file path"))
+    tests_raw = data.get("tests")
+    tests: list[ScriptTest] = []
+    if not isinstance(tests_raw, list) or not tests_raw:
+        errors.append(src.diagnostic(("tests",) if "tests" in data else (), "'tests:' must be a non-empty list", ""))
+        tests_raw = []
+    for i, t in enumerate(tests_raw):
+        if not isinstance(t, dict) or not isinstance(t.get("name"), str) or not isinstance(t.get("steps"), list):
+            errors.append(src.diagnostic(("tests", i), "each test needs 'name:' and a list of 'steps:'", ""))
+            continue
+        for key in t:
+            if key not in ("name", "steps"):
+                errors.append(src.diagnostic(("tests", i, key), f"unknown key '{key}' in a test", "", at_key=True))
+        steps = []
+        for j, s in enumerate(t["steps"]):
+            if not isinstance(s, str):
+                errors.append(src.diagnostic(("tests", i, "steps", j), "a step is one command as text",
+                                             "quote it if it contains ':'"))
+                continue
+            word = s.split("#", 1)[0].split()[:1]
+            if word and word[0] not in COMMANDS:
+                errors.append(src.diagnostic(("tests", i, "steps", j), f"unknown command '{word[0]}'",
+                                             f"commands: {', '.join(sorted(COMMANDS))}"))
+            steps.append(Step(s, src.mark(("tests", i, "steps", j)).line))
+        tests.append(ScriptTest(t["name"], steps, src.mark(("tests", i)).line))
+    cycle_ms = data.get("cycle_ms", 250)
+    if not isinstance(cycle_ms, int | float) or isinstance(cycle_ms, bool) or not 10 <= cycle_ms <= 2000:
+        errors.append(src.diagnostic(("cycle_ms",), "cycle_ms must be a number from 10 to 2000", ""))
+        cycle_ms = 250
+    if errors:
+        raise StationError(errors)
+    return Script(str(path), str(station), tests, cycle_ms / 1000.0)
+
+
+def _resolve_station(script: Script, src_dir: Path) -> Station:
+    try:
+        return load(script.station)
+    except StationError:
+        candidate = src_dir / script.station
+        if candidate.exists():
+            return load(candidate)
+        raise
+
+
+def run_script(script: Script, only: str | None = None) -> list[Outcome]:
+    station = _resolve_station(script, Path(script.file).parent)
+    from interlocking.table import build_table
+
+    table = build_table(station)
+    outcomes = []
+    for test in script.tests:
+        if only and only.lower() not in test.name.lower():
+            continue
+        outcomes.append(run_test(script, test, station, table))
+    return outcomes
+
+
+def run_test(script: Script, test: ScriptTest, station: Station, table: object) -> Outcome:
+    sim = Simulation(station, cycle_s=script.cycle_s, table=table)  # type: ignore[arg-type]
+    log: list[str] = []
+    steps = test.steps
+    for k, step in enumerate(steps):
+        result = sim.command(step.text)
+        log.append(f"{step.text} -> {'ok' if result.ok else 'refused'}: {result.message}")
+        is_expect = step.text.strip().startswith("expect")
+        if result.ok:
+            continue
+        if not is_expect:
+            nxt = steps[k + 1].text.strip() if k + 1 < len(steps) else ""
+            if nxt.startswith("expect refused"):
+                continue
+            return Outcome(script.file, test.name, False,
+                           f"step '{step.text}' was refused: {result.message}", step.line, log)
+        return Outcome(script.file, test.name, False, f"step '{step.text}': {result.message} (t = {sim.t:g} s)",
+                       step.line, log)
+    return Outcome(script.file, test.name, True, log=log)
