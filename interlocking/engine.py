@@ -109,6 +109,8 @@ class Interlocking(OperatorMixin):
                 if ts.squeeze_alarmed:
                     ts.squeeze_alarmed = False
                     self.clear_alarm(f"squeeze:{t_id}")
+        for sig in signals:
+            self._lamp_alarms(sig)
         self._supervise_turnouts()
         for rs in list(self.routes.values()):
             self._advance(rs)
@@ -118,8 +120,27 @@ class Interlocking(OperatorMixin):
             self._update_block_signals()
         if self.codes_dirty or self.out.changed_signals:
             self._update_cab_codes()
-        del signals, doors
+        del doors
         return self.out
+
+    def _lamp_alarms(self, signal: str) -> None:
+        """Flasher (SNJ/SNJJ) and red-lamp supervision of one signal whose proving relays changed."""
+        sig = self.station.signals[signal]
+        if sig.usu:
+            if self.board.flasher_ok(signal):
+                self.clear_alarm(f"flasher:{signal}")
+            else:
+                self.alarm(f"flasher:{signal}", f"signal {signal}: USU flasher failed (SNJ/SNJJ down); USU "
+                           "degrades to UU")
+        stop = "A" if sig.kind is SignalKind.shunting else "H"
+        if stop in [lamp.value for lamp in sig.lamps]:
+            dark = not self.board.lamp_ok(signal, stop)
+            if dark != self.signals[signal].red_dark:
+                self.signals[signal].red_dark = dark
+                if dark:
+                    self.alarm(f"red:{signal}", f"signal {signal}: {stop} lamp dark (both filaments)")
+                else:
+                    self.clear_alarm(f"red:{signal}")
 
     # ---- turnouts -------------------------------------------------------------------------------------------
     def _supervise_turnouts(self) -> None:

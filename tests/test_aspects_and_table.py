@@ -1,0 +1,128 @@
+"""Aspect rules (pluggable Chinese set), lamp downgrade, and the interlocking table's properties."""
+
+from __future__ import annotations
+
+import itertools
+import json
+
+import pytest
+from conftest import Driver
+from hypothesis import given
+from hypothesis import strategies as st
+
+from interlocking.aspects import ORDER, downgrade
+from interlocking.rules import load_rules
+from interlocking.table import build_table
+from simulation.cli import main
+from stations.library import bundled
+from stations.loader import load, load_text
+from stations.source import StationError
+
+RULES = load_rules()
+ALL_LAMPS = ["L", "L2", "U", "U2", "H", "B", "A", "flasher"]
+
+
+@given(st.sampled_from(sorted(RULES.downgrade)), st.sets(st.sampled_from(ALL_LAMPS)))
+def test_a_dark_lamp_never_makes_an_aspect_more_permissive(aspect: str, dark: set[str]) -> None:
+    assert ORDER[downgrade(aspect, dark, RULES)] <= ORDER[aspect]
+
+
+@pytest.mark.parametrize(("aspect", "dark", "shown"), [
+    ("LU", {"L"}, "U"),  # a dark green on LU leaves U
+    ("UU", {"U2"}, "H"),  # a dark second yellow must give H, not a lone U
+    ("USU", {"flasher"}, "UU"),
+    ("L", {"L"}, "H"),
+    ("B", {"B"}, "A"),
+    ("L", set(), "L"),
+])
+def test_downgrade_order(aspect: str, dark: set[str], shown: str) -> None:
+    assert downgrade(aspect, dark, RULES) == shown
+
+
+def test_dark_green_on_home_signal_closes_it(jiaopei: Driver) -> None:
+    jiaopei("route X XI", "route XI S", "block-line SL request", "run 6s", "expect signal X L")
+    jiaopei.sim.field.set_lamp_dark("X", "L", True)
+    jiaopei("run 1s", "expect signal X H", "expect alarm lamp(s) L dark")
+
+
+def test_dark_yellow_closes_the_signal_and_it_stays_closed(jiaopei: Driver) -> None:
+    jiaopei("route X XI", "run 1s", "expect signal X U")
+    jiaopei.sim.field.set_lamp_dark("X", "U", True)
+    jiaopei("run 1s", "expect signal X H")
+    jiaopei.sim.field.set_lamp_dark("X", "U", False)
+    jiaopei("run 5s", "expect signal X H", "reopen X", "run 1s", "expect signal X U")
+
+
+def test_red_lamp_transfer_keeps_the_signal_in_rear_closed(jiaopei: Driver) -> None:
+    jiaopei.sim.field.set_lamp_dark("XI", "H", True)
+    jiaopei("run 1s", "expect alarm XI: H lamp dark", "route X XI", "run 1s", "expect signal X H")
+
+
+# ---- table ------------------------------------------------------------------------------------------------------
+@pytest.mark.parametrize("name", sorted(bundled()))
+def test_conflicts_are_complete_and_symmetric(name: str) -> None:
+    table = build_table(load(name))
+    routes = list(table.routes.values())
+    assert routes
+    for a, b in itertools.combinations(routes, 2):
+        share = set(a.all_sections) & set(b.all_sections)
+        pa = {t.id: t.position for t in a.all_turnouts}
+        opposite = any(pa.get(t.id) not in (None, t.position) for t in b.all_turnouts)
+        must = bool(share) or opposite
+        assert (b.id in a.conflicts) == must, (a.id, b.id, share, opposite)
+        assert (a.id in b.conflicts) == (b.id in a.conflicts)
+
+
+def test_jiaopei_table_rows_a_signal_engineer_expects() -> None:
+    table = build_table(load("jiaopei"))
+    r = table.routes["X-XI"]
+    assert r.category == "receiving" and r.sections == ("7DG", "1DG", "IG") and r.approach == ("IAG",)
+    assert {(t.id, t.position.value, t.role) for t in r.turnouts} == {
+        ("7", "normal", "route"), ("1", "normal", "route"), ("3", "normal", "protection")}
+    assert r.aspects == ("L", "LU", "U")
+    assert table.routes["X-X3"].aspects == ("UU",)  # No. 12 turnouts: no USU
+    assert table.routes["XI-S"].category == "departure" and table.routes["XI-S"].exit_link == "SL"
+    assert "S-SI" in r.opposing and "X-X3" not in r.opposing
+    assert table.routes["D1-5GA"].sections[-1] == "5G"  # shunting to the buffer stop of the spur
+    assert table.throats == {"X": ("1", "3", "5", "7"), "S": ("2", "4", "6")}
+
+
+def test_gaotie_home_signal_may_show_usu_over_no18() -> None:
+    table = build_table(load("gaotie"))
+    assert "USU" in table.routes["X-X3"].aspects
+    assert table.routes["XI-XFCK"].aspects == ("L", "LU", "U")
+
+
+def test_override_forbid_removes_a_route_and_unknown_route_is_an_error_with_line() -> None:
+    base = bundled()["jiaopei"].read_text(encoding="utf-8")
+    table = build_table(load_text(base + "overrides:\n  forbid: [D1-5GA]\n", "j.yaml"))
+    assert "D1-5GA" not in table.routes
+    with pytest.raises(StationError) as err:
+        build_table(load_text(base + "overrides:\n  forbid: [D1-NOPE]\n", "j.yaml"))
+    d = err.value.diagnostics[0]
+    assert d.file == "j.yaml" and d.line == base.count("\n") + 2 and "D1-NOPE" in d.message
+
+
+def test_override_protection_adds_a_protection_turnout() -> None:
+    base = bundled()["jiaopei"].read_text(encoding="utf-8")
+    extra = "overrides:\n  protection: [{route: XI-S, turnout: \"5\", position: normal}]\n"
+    r = build_table(load_text(base + extra, "j.yaml")).routes["XI-S"]
+    assert any(t.id == "5" and t.role == "protection" for t in r.turnouts)
+
+
+@pytest.mark.parametrize("fmt", ["text", "csv", "json"])
+def test_table_command_formats(fmt: str, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["table", "jiaopei", "--format", fmt]) == 0
+    out = capsys.readouterr().out
+    if fmt == "json":
+        data = json.loads(out)
+        assert data["station"] == "jiaopei"
+        row = next(r for r in data["routes"] if r["id"] == "X-XI")
+        assert {"id", "kind", "start", "end", "via", "signal", "turnouts", "sections", "approach",
+                "conflicts"} <= set(row)
+        assert row["kind"] == "train" and {"id": "3", "position": "normal", "role": "protection"} in row["turnouts"]
+    elif fmt == "csv":
+        assert out.splitlines()[0].startswith("id,kind,category")
+        assert any(line.startswith("X-XI,train,receiving") for line in out.splitlines())
+    else:
+        assert "联锁表" in out and "X-XI" in out and "[3]" in out
