@@ -230,7 +230,11 @@ class _Builder:
                     u = far.node
                     if far.leg != "point" and u not in route_pos:
                         other = TurnoutPosition.reverse if far.leg == "normal" else TurnoutPosition.normal
-                        protection.setdefault(u, other)
+                        # a protection position must lead away from the route, never into one of its sections
+                        # (in a scissors crossover the other diagonal crosses the route at the diamond)
+                        away = self.st.tracks[self.st.leg_track(u, other.value)].section
+                        if away not in path.sections:
+                            protection.setdefault(u, other)
                     break
                 if far.node not in self.st.joints or travelled > _FLANK_SEARCH_M:
                     break

@@ -126,3 +126,17 @@ def test_table_command_formats(fmt: str, capsys: pytest.CaptureFixture[str]) -> 
         assert any(line.startswith("X-XI,train,receiving") for line in out.splitlines())
     else:
         assert "联锁表" in out and "X-XI" in out and "[3]" in out
+
+
+def test_variant_route_by_via_button_takes_the_detour(capsys: pytest.CaptureFixture[str]) -> None:
+    from simulation.sim import Simulation
+
+    table = build_table(load("gaotie"))
+    v = table.routes["X-XI(BA1)"]
+    assert v.via == ("BA1",) and "11-13DG" in v.sections and v.aspects == ("UU",)
+    assert "X-XI" in v.conflicts  # same start signal, shared sections
+    # a scissors diagonal is never used as flank protection for a route over the other diagonal
+    assert not any(t.id in ("5", "7") and t.role == "protection" for t in v.turnouts)
+    d = Driver(Simulation("gaotie"))
+    d("route X BA1 XI", "run 15s", "expect turnout 13 reverse locked", "expect turnout 1 reverse locked",
+      "expect signal X UU", "expect route X-XI(BA1) open")

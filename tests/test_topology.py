@@ -144,17 +144,27 @@ def test_jiaopei_up_departures_reach_the_x_end(jiaopei: Station) -> None:
 
 # ---- gaotie: receiving routes ------------------------------------------------------------------------------
 def test_gaotie_x_to_xi_is_straight_through_the_scissors(gaotie: Station) -> None:
-    p = only_path(gaotie, "X", "XI")
-    assert p.sections == ("1-7DG", "9DG", "IG")
+    p = gaotie.topology.shortest("X", "XI")
+    assert p is not None
+    assert p.sections == ("1-7DG", "9-15DG", "IG")
     assert all(pos is N for _, pos in p.turnouts)
-    assert [t for t, _ in p.turnouts] == ["1", "7", "9"]
+    assert [t for t, _ in p.turnouts] == ["1", "7", "15", "9"]
+
+
+def test_gaotie_x_to_xi_has_a_detour_over_line_ii(gaotie: Station) -> None:
+    paths = gaotie.topology.paths_from_signal("X", "XI")
+    assert len(paths) == 2
+    detour = max(paths, key=lambda p: p.length)
+    assert detour.sections == ("1-7DG", "3-5DG", "11-13DG", "9-15DG", "IG")
+    assert dict(detour.turnouts) == {"1": R, "3": R, "13": R, "15": R, "9": N}
 
 
 def test_gaotie_x_to_x3_diverges_over_a_no18_turnout(gaotie: Station) -> None:
     """The home signal may show USU only when every reverse turnout of the route is No. 18 or larger."""
-    p = only_path(gaotie, "X", "X3")
-    assert p.sections == ("1-7DG", "9DG", "3G")
-    assert dict(p.turnouts) == {"1": N, "7": N, "9": R}
+    p = gaotie.topology.shortest("X", "X3")
+    assert p is not None
+    assert p.sections == ("1-7DG", "9-15DG", "3G")
+    assert dict(p.turnouts) == {"1": N, "7": N, "15": N, "9": R}
     reverse = [t for t, pos in p.turnouts if pos is R]
     assert reverse and all(gaotie.turnouts[t].number >= 18 for t in reverse)
     x = gaotie.signals["X"]
@@ -189,8 +199,8 @@ def test_gaotie_up_departures_end_at_the_exit_button(gaotie: Station) -> None:
     exit_node = gaotie.buttons["SFCK"].at
     sii = only_path(gaotie, "SII", exit_node)
     s4 = only_path(gaotie, "S4", exit_node)
-    assert dict(sii.turnouts) == {"11": N, "3": N, "5": N}
-    assert dict(s4.turnouts) == {"11": R, "3": N, "5": N}
+    assert dict(sii.turnouts) == {"11": N, "13": N, "3": N, "5": N}
+    assert dict(s4.turnouts) == {"11": R, "13": N, "3": N, "5": N}
     link = next(lk for lk in gaotie.model.links if lk.id == "XL-II")
     (onward,) = gaotie.topology.walk(exit_node, UP)
     assert onward.end == link.end and list(onward.sections) == link.sections
@@ -213,19 +223,21 @@ def test_gaotie_open_line_block_signals_and_approach_sections(gaotie: Station) -
 def test_gaotie_scissors_offers_both_diagonals_to_down_movements(gaotie: Station) -> None:
     # line I -> line II over 1/3 (from home signal X to starting signal SII's joint)
     to_ii = only_path(gaotie, "X", "SII")
-    assert dict(to_ii.turnouts) == {"1": R, "3": R, "11": N}
+    assert dict(to_ii.turnouts) == {"1": R, "3": R, "13": N, "11": N}
     assert "J-13" in to_ii.joints and to_ii.sections[:2] == ("1-7DG", "3-5DG")
-    # line II -> line I over 5/7 (from shunting signal D1 to D3 at the end of IG)
-    to_i = only_path(gaotie, "D1", "D3")
-    assert dict(to_i.turnouts) == {"5": R, "7": R, "9": N}
+    # line II -> line I over 5/7 (from shunting signal D1 to D3 at the end of IG); crossover 13/15 is the other way
+    paths = gaotie.topology.paths_from_signal("D1", "D3")
+    to_i = next(p for p in paths if p.uses_turnout("5") is R)
+    assert dict(to_i.turnouts) == {"5": R, "7": R, "15": N, "9": N}
     assert "J-57" in to_i.joints and to_i.sections[:2] == ("3-5DG", "1-7DG")
+    assert {tuple(sorted(dict(p.turnouts))) for p in paths} == {("15", "5", "7", "9"), ("13", "15", "3", "5", "9")}
 
 
 def test_gaotie_scissors_offers_both_diagonals_to_up_movements(gaotie: Station) -> None:
     to_i = only_path(gaotie, "SII", "X")
-    assert dict(to_i.turnouts) == {"11": N, "3": R, "1": R}
-    to_ii = only_path(gaotie, "D3", "D1")
-    assert dict(to_ii.turnouts) == {"9": N, "7": R, "5": R}
+    assert dict(to_i.turnouts) == {"11": N, "13": N, "3": R, "1": R}
+    to_ii = next(p for p in gaotie.topology.paths_from_signal("D3", "D1") if p.uses_turnout("7") is R)
+    assert dict(to_ii.turnouts) == {"9": N, "15": N, "7": R, "5": R}
 
 
 def test_gaotie_scissors_crossovers_are_laid_in_opposite_directions(gaotie: Station) -> None:
