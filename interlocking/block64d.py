@@ -1,8 +1,8 @@
 """64D semi-automatic block (64D 半自动闭塞) between this station and a neighbour, from this station's side.
 
 The two block machines talk by line pulses (each sent for a few seconds): REQUEST (闭塞请求), ACCEPT (同意),
-DEPART (出发通知), RESTORE (到达复原 / 取消复原), ACCIDENT (事故复原). Departure needs the neighbour's acceptance; once the
-train occupies the departure section the line is blocked until the neighbour restores it after the arrival.
+DEPART (出发通知), RESTORE (到达复原 / 取消复原), ACCIDENT (事故复原). Departure needs the neighbour's acceptance;
+once the train occupies the departure section the line is blocked until the neighbour restores it after the arrival.
 """
 
 from __future__ import annotations
@@ -37,7 +37,8 @@ class BlockLink:
         s = self.state
         if action == "request":
             if s is not BlockState.idle:
-                return f"block line {self.id} is not clear ({s.value}); a request needs the line in its normal state", ""
+                return (f"block line {self.id} is not clear ({s.value}); a request needs the line in its normal "
+                        "state"), ""
             self.state = BlockState.requested
             return "", REQUEST
         if action == "accept":

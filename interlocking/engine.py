@@ -20,7 +20,6 @@ from stations.station import Station
 from .aspects import downgrade, is_open, select_aspect, stop_aspect
 from .block64d import BlockLink
 from .io import Alarm, DoorCommand, Event, Outputs, RelayBoard
-from .operations import OperatorMixin
 from .rules import RuleSet, load_rules
 from .state import RouteStage, RouteState, SignalState, TurnoutState
 from .table import InterlockingTable, Route
@@ -28,8 +27,9 @@ from .table import InterlockingTable, Route
 MAX_EVENTS = 20_000
 
 
-class Interlocking(OperatorMixin):
-    """One station's interlocking, driven by ``cycle(t)`` and operator commands."""
+class Engine:
+    """One station's interlocking logic, driven by ``cycle(t)``; :class:`~interlocking.operations.Interlocking`
+    adds the operator commands."""
 
     def __init__(self, table: InterlockingTable, rules: RuleSet | None = None, cycle_s: float = 0.25) -> None:
         self.table = table
@@ -47,8 +47,8 @@ class Interlocking(OperatorMixin):
         st = self.station
         self.turnouts = {t: TurnoutState(t, st.turnout_section[t], st.turnouts[t].trailable) for t in st.turnouts}
         self.signals = {s.id: SignalState(s.id, stop_aspect(st, s.id)) for s in st.model.signals}
-        for s in st.model.signals:
-            self.out.set_aspect(s.id, stop_aspect(st, s.id))
+        for sig in st.model.signals:
+            self.out.set_aspect(sig.id, stop_aspect(st, sig.id))
         self.links = {lk.id: BlockLink(lk.id, lk.sections[0] if lk.sections else "")
                       for lk in st.model.links if lk.kind.value == "64d"}
         self.auto_links = {lk.id: tuple(lk.sections) for lk in st.model.links if lk.kind.value == "automatic"}
@@ -62,8 +62,8 @@ class Interlocking(OperatorMixin):
         self.alarms: dict[str, Alarm] = {}
         self.entry_section = {s: st.tracks[st.signal_entry_track(s)].section for s in st.signals}
         self.signal_by_entry: dict[str, list[str]] = {}
-        for s, sec in self.entry_section.items():
-            self.signal_by_entry.setdefault(sec, []).append(s)
+        for sig_id, sec in self.entry_section.items():
+            self.signal_by_entry.setdefault(sec, []).append(sig_id)
         self.platform_doors = {p.section: [f"{p.id}:{d.side.value}" for d in p.screen_doors]
                                for p in st.model.platforms if p.screen_doors}
         self._block_signals = self._chain_block_signals()
@@ -215,9 +215,8 @@ class Interlocking(OperatorMixin):
                 # a movement entered under a closed signal (detected as SPAD); release behind it
                 rs.entered = True
                 rs.stage = RouteStage.in_use
-            elif not rs.opened_once and not rs.needs_reopen and not rs.guide:
-                if not self.open_blocker(rs):
-                    self._open(rs)
+            elif not (rs.opened_once or rs.needs_reopen or rs.guide or self.open_blocker(rs)):
+                self._open(rs)
             return
         if rs.stage is RouteStage.open:
             self._keep_open(rs)
@@ -413,9 +412,8 @@ class Interlocking(OperatorMixin):
             if not rs.was_occupied[i] or not self.clear(s):
                 break
             nxt = secs[i + 1] if i < last else r.beyond
-            if nxt is not None and self.clear(nxt):
-                if not (r.kind == "shunt" and not any_occupied):
-                    break  # the movement has not reached the next section
+            if nxt is not None and self.clear(nxt) and not (r.kind == "shunt" and not any_occupied):
+                break  # the movement has not reached the next section
             self._release_section(rs, i)
         if r.kind == "shunt" and not any_occupied and any(rs.released) and not all(rs.released):
             # partial release: the shunting movement drew back out of the route
@@ -504,9 +502,9 @@ class Interlocking(OperatorMixin):
                 if is_open(self.out.signals.get(sig, "")):
                     continue
                 owner = self.section_lock.get(sec)
-                if owner is not None and owner in self.routes and owner != self.by_signal.get(sig):
-                    if self.routes[owner].route.direction is not self.station.signals[sig].direction:
-                        continue  # a movement from the other side, in its own route
+                if (owner is not None and owner in self.routes and owner != self.by_signal.get(sig)
+                        and self.routes[owner].route.direction is not self.station.signals[sig].direction):
+                    continue  # a movement from the other side, in its own route
                 rear = self.station.signal_rear_track(sig)
                 if rear is None or self.clear(self.station.tracks[rear].section):
                     continue

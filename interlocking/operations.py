@@ -3,26 +3,22 @@ signaller's terms. Commands act on the current state at once; the routes then pr
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 from stations.schema import Button, SignalKind
 
 from .aspects import stop_aspect
+from .engine import Engine
 from .io import Result
 from .state import RouteStage, RouteState
 from .table import Kind, Route
 
-if TYPE_CHECKING:
-    from .engine import Interlocking
-
 _KIND_WORD = {"train": "train", "shunt": "shunting"}
 
 
-class OperatorMixin:
-    """Mixed into :class:`~interlocking.engine.Interlocking`."""
+class Interlocking(Engine):
+    """A station's CBI: the cycle of :class:`~interlocking.engine.Engine` plus the operator's commands."""
 
     # ---- route setting ----------------------------------------------------------------------------------------
-    def set_route(self: Interlocking, kind: Kind, start: str, end: str, via: tuple[str, ...] = ()) -> Result:
+    def set_route(self, kind: Kind, start: str, end: str, via: tuple[str, ...] = ()) -> Result:
         """Select a route by its start, optional variant and end buttons (列车/调车进路)."""
         st = self.station
         known = set(st.signals) | set(st.buttons)
@@ -62,7 +58,7 @@ class OperatorMixin:
         self.event("route", f"route {r.id} selected")
         return Result.accept(f"route {r.id} selected")
 
-    def route_blocker(self: Interlocking, r: Route) -> str:
+    def route_blocker(self, r: Route) -> str:
         if r.signal in self.by_signal:
             return f"signal {r.signal} already has route {self.by_signal[r.signal]} set"
         for other, why in r.conflicts.items():
@@ -93,15 +89,15 @@ class OperatorMixin:
                     return f"turnout {member} cannot move: section {ms.section} is occupied"
         return ""
 
-    def route_of(self: Interlocking, signal: str) -> RouteState | None:
+    def route_of(self, signal: str) -> RouteState | None:
         rid = self.by_signal.get(signal)
         return self.routes.get(rid) if rid else None
 
-    def approach_locked(self: Interlocking, rs: RouteState) -> bool:
+    def approach_locked(self, rs: RouteState) -> bool:
         """接近锁闭: the signal has been open and a train is in the approach section."""
         return rs.opened_once and any(not self.clear(s) for s in rs.route.approach)
 
-    def _need_route(self: Interlocking, signal: str) -> tuple[RouteState | None, str]:
+    def _need_route(self, signal: str) -> tuple[RouteState | None, str]:
         if signal not in self.station.signals:
             return None, f"there is no signal '{signal}' at {self.station.id}"
         rs = self.route_of(signal)
@@ -110,7 +106,7 @@ class OperatorMixin:
         return rs, ""
 
     # ---- cancel, manual release, section fault release, reopen ----------------------------------------------
-    def cancel(self: Interlocking, signal: str) -> Result:
+    def cancel(self, signal: str) -> Result:
         """总取消: cancel a route at once while its approach section is clear."""
         if signal in self.guide_only:
             del self.guide_only[signal]
@@ -133,11 +129,11 @@ class OperatorMixin:
         self.event("route", f"route {rs.id} cancelled")
         return Result.accept(f"route {rs.id} cancelled")
 
-    def _close_if_open(self: Interlocking, rs: RouteState, reason: str) -> None:
+    def _close_if_open(self, rs: RouteState, reason: str) -> None:
         if self.out.signals.get(rs.route.signal) != stop_aspect(self.station, rs.route.signal):
             self.close_signal(rs, reason, abnormal=False)
 
-    def release(self: Interlocking, signal: str) -> Result:
+    def release(self, signal: str) -> Result:
         """总人解: close the signal and release after 180 s (train) / 30 s (shunting), everything still checked."""
         rs, why = self._need_route(signal)
         if rs is None:
@@ -160,13 +156,13 @@ class OperatorMixin:
         self.event("route", f"manual time release of {rs.id}: {delay:g} s")
         return Result.accept(f"route {rs.id} releases in {delay:g} s unless a train enters")
 
-    def release_delay(self: Interlocking, r: Route) -> float:
+    def release_delay(self, r: Route) -> float:
         sig = self.station.signals[r.signal]
         if sig.release_s is not None:
             return sig.release_s
         return self.rules.release_s["shunt" if r.kind == "shunt" else "train"]
 
-    def fault_release(self: Interlocking, section: str) -> Result:
+    def fault_release(self, section: str) -> Result:
         """区故解: release one locked, clear section (never a station track)."""
         st = self.station
         if section not in st.sections:
@@ -204,7 +200,7 @@ class OperatorMixin:
             self.finish(rs, all_sections=False)
         return Result.accept(f"section {section} released")
 
-    def reopen(self: Interlocking, signal: str) -> Result:
+    def reopen(self, signal: str) -> Result:
         """重复开放: reopen a signal closed abnormally, once its conditions are back."""
         rs, why = self._need_route(signal)
         if rs is None:
@@ -223,7 +219,7 @@ class OperatorMixin:
         return Result.accept(f"signal {signal} reopened")
 
     # ---- guide ------------------------------------------------------------------------------------------------
-    def guide(self: Interlocking, signal: str) -> Result:
+    def guide(self, signal: str) -> Result:
         """引导: open HB over a set route without checking its track circuits, or over a guide-locked throat."""
         st = self.station
         if signal not in st.signals:
@@ -263,7 +259,7 @@ class OperatorMixin:
         self.event("signal", f"guide aspect HB on {signal} under guide total lock")
         return Result.accept(f"guide aspect HB on {signal} (guide total lock)")
 
-    def guide_lock(self: Interlocking, throat: str, lock: bool) -> Result:
+    def guide_lock(self, throat: str, lock: bool) -> Result:
         """引导总锁闭: lock (or unlock) every turnout of a throat."""
         if throat not in self.table.throats:
             names = ", ".join(sorted(self.table.throats))
@@ -282,14 +278,14 @@ class OperatorMixin:
         return Result.accept(f"throat {throat} {word}: turnouts {', '.join(turnouts)}")
 
     # ---- turnouts ---------------------------------------------------------------------------------------------
-    def _turnout_ids(self: Interlocking, name: str) -> list[str] | None:
+    def _turnout_ids(self, name: str) -> list[str] | None:
         if name in self.station.turnouts:
             return self.pair_members(name)
         if name in self.station.pairs:
             return list(self.station.pairs[name])
         return None
 
-    def throw(self: Interlocking, name: str, position: str) -> Result:
+    def throw(self, name: str, position: str) -> Result:
         """单操: individual operation of a turnout (a crossover pair moves together)."""
         ids = self._turnout_ids(name)
         if ids is None:
@@ -313,7 +309,7 @@ class OperatorMixin:
         self.event("turnout", f"turnout {name} to {position} (individual operation)")
         return Result.accept(f"turnout {name} moving to {position}")
 
-    def single_lock(self: Interlocking, name: str, on: bool) -> Result:
+    def single_lock(self, name: str, on: bool) -> Result:
         ids = self._turnout_ids(name)
         if ids is None:
             return Result.refuse(f"there is no turnout '{name}' at {self.station.id}")
@@ -322,7 +318,7 @@ class OperatorMixin:
         self.event("turnout", f"turnout {name} single-{'locked' if on else 'unlocked'}")
         return Result.accept(f"turnout {name} {'single-locked (单锁)' if on else 'unlocked (单解)'}")
 
-    def single_block(self: Interlocking, name: str, on: bool) -> Result:
+    def single_block(self, name: str, on: bool) -> Result:
         ids = self._turnout_ids(name)
         if ids is None:
             return Result.refuse(f"there is no turnout '{name}' at {self.station.id}")
@@ -332,7 +328,7 @@ class OperatorMixin:
         return Result.accept(f"turnout {name} {'single-blocked (单封)' if on else 'unblocked (解封)'}")
 
     # ---- 64D block and platform doors ------------------------------------------------------------------------
-    def block_line(self: Interlocking, link: str, action: str) -> Result:
+    def block_line(self, link: str, action: str) -> Result:
         bl = self.links.get(link)
         if bl is None:
             names = ", ".join(sorted(self.links)) or "none"
@@ -346,7 +342,7 @@ class OperatorMixin:
         self.event("block", f"block line {link}: {action}, {before.value} -> {bl.state.value}")
         return Result.accept(f"block line {link}: {bl.state.value}")
 
-    def doors(self: Interlocking, platform: str, action: str) -> Result:
+    def doors(self, platform: str, action: str) -> Result:
         p = next((p for p in self.station.model.platforms if p.id == platform), None)
         if p is None or not p.screen_doors:
             return Result.refuse(f"there is no platform with screen doors '{platform}'")

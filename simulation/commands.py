@@ -185,8 +185,7 @@ def _expect(sim: Simulation, args: list[str]) -> Result:
         return Result(bl.state.value == rest[1], f"block line {rest[0]} is {bl.state.value}")
     if what == "code" and len(rest) == 2:
         s, want = rest
-        got = il.out.cab_codes.get(s)
-        shown = got or "none"
+        shown = il.out.cab_codes.get(s) or "none"
         return Result(shown == want, f"section {s} carries code {shown}" + ("" if shown == want else
                                                                               f", expected {want}"))
     return Result.refuse(f"usage: {USAGE['expect']}")

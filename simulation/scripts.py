@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from stations.loader import load
-from stations.source import Diagnostic, Source, StationError, read_file
+from stations.source import Diagnostic, StationError, read_file
 from stations.station import Station
 
 from .commands import COMMANDS

@@ -8,8 +8,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from interlocking.engine import Interlocking
 from interlocking.io import Result
+from interlocking.operations import Interlocking
 from interlocking.rules import RuleSet, load_rules
 from interlocking.state import RouteStage
 from interlocking.table import InterlockingTable, build_table
@@ -26,8 +26,8 @@ class Simulation:
         self.rules = load_rules(rules) if isinstance(rules, str) else rules
         self.table = table or build_table(self.station)
         self.cycle_s = cycle_s
-        self.interlocking = Interlocking(self.table, self.rules, cycle_s)
-        self.field = IdealField(self.station, self.rules)
+        self.interlocking: Interlocking = Interlocking(self.table, self.rules, cycle_s)
+        self.field: IdealField = IdealField(self.station, self.rules)
         self.t = 0.0
         self.last_result: Result | None = None
         self.field.publish(self.interlocking.board)

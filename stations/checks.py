@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from collections import Counter
 from collections.abc import Iterator, Sequence
+from itertools import pairwise
 
 import networkx as nx
 
@@ -103,7 +104,7 @@ class _Checker:
 
     def node_usage(self) -> None:
         use: dict[tuple[str, str | None], list[tuple[int, str]]] = {}
-        for i, tid, a, b in self._track_ports():
+        for i, _, a, b in self._track_ports():
             use.setdefault((a.node, a.leg), []).append((i, "from"))
             use.setdefault((b.node, b.leg), []).append((i, "to"))
         for k, e in enumerate(self.m.ends):
@@ -147,11 +148,11 @@ class _Checker:
                          f"turnout {t.id}: the point leg leaves on the same side as the normal and reverse legs",
                          "the point leg goes one way from the turnout, the normal and reverse legs the other")
         for k, j in enumerate(self.m.joints):
-            sides = {other[(j.id, None)] > j.at}
-            tracks_here = [t for t in self.m.tracks if parse_port(t.start).node == j.id or parse_port(t.end).node == j.id]
+            tracks_here = [tr for tr in self.m.tracks
+                           if parse_port(tr.start).node == j.id or parse_port(tr.end).node == j.id]
             positions = []
-            for t in tracks_here:
-                a, b = parse_port(t.start), parse_port(t.end)
+            for tr in tracks_here:
+                a, b = parse_port(tr.start), parse_port(tr.end)
                 positions.append(pos[b.node] if a.node == j.id else pos[a.node])
             sides = {p > j.at for p in positions}
             if len(sides) != 2:
@@ -214,7 +215,7 @@ class _Checker:
                              f"turnout {node} has tracks of different sections ({', '.join(sorted(secs))}) on its legs",
                              "a turnout lies inside one section: put its three leg tracks in the same section, "
                              "or place joints between them")
-                for a_, b_ in zip(items, items[1:], strict=False):
+                for a_, b_ in pairwise(items):
                     g.add_edge(self.m.tracks[a_[0]].id, self.m.tracks[b_[0]].id)
         for k, s in enumerate(self.m.sections):
             tracks = [t.id for t in self.m.tracks if t.section == s.id]
@@ -326,7 +327,8 @@ class _Checker:
             xb = self.node_positions[parse_port(t.end).node]
             if not min(xa, xb) <= f.at <= max(xa, xb):
                 self.err(("fouling_points", k, "at"),
-                         f"fouling point {f.id} at {f.at:g} m is off track '{t.id}' ({min(xa, xb):g}-{max(xa, xb):g} m)",
+                         f"fouling point {f.id} at {f.at:g} m is off track '{t.id}' "
+                         f"({min(xa, xb):g}-{max(xa, xb):g} m)",
                          "a fouling point lies on its track, between the track's two ends")
 
     def platforms(self) -> None:

@@ -91,9 +91,9 @@ class Station:
                 if p.leg is not None:
                     self.turnout_section[p.node] = self.tracks[tid].section
         self.pairs: dict[str, list[str]] = {}
-        for t in model.turnouts:
-            if t.pair:
-                self.pairs.setdefault(t.pair, []).append(t.id)
+        for turnout in model.turnouts:
+            if turnout.pair:
+                self.pairs.setdefault(turnout.pair, []).append(turnout.id)
 
     # ---- geometry -------------------------------------------------------------------------------------------
     def node_at(self, node: str) -> float:
@@ -109,11 +109,18 @@ class Station:
         return (xa, xb) if xa <= xb else (xb, xa)
 
     def track_length(self, track: str) -> float:
-        t = self.tracks[track]
-        if t.length is not None:
-            return t.length
-        lo, hi = self.track_span(track)
-        return hi - lo
+        return self._track_lengths[track]
+
+    @cached_property
+    def _track_lengths(self) -> dict[str, float]:
+        out = {}
+        for tid, t in self.tracks.items():
+            if t.length is not None:
+                out[tid] = t.length
+            else:
+                lo, hi = self.track_span(tid)
+                out[tid] = hi - lo
+        return out
 
     def track_low_port(self, track: str) -> Port:
         """The port of ``track`` at its lower position (towards the X end)."""
@@ -188,7 +195,14 @@ class Station:
         return [self.tracks[rear].section] if rear else []
 
     def signals_at(self, node: str) -> list[Signal]:
-        return [s for s in self.model.signals if s.at == node]
+        return list(self._signals_by_node.get(node, ()))
+
+    @cached_property
+    def _signals_by_node(self) -> dict[str, list[Signal]]:
+        out: dict[str, list[Signal]] = {}
+        for s in self.model.signals:
+            out.setdefault(s.at, []).append(s)
+        return out
 
     def is_station_track(self, section: str) -> bool:
         return self.sections[section].role is SectionRole.station_track
