@@ -31,7 +31,15 @@ _HINTS = {
     "list_type": "write a list ('- item' lines)",
     "model_type": "write a mapping ('key: value' lines)",
     "too_short": "the list needs at least one item",
+    "string_too_short": "write a non-empty text",
+    "int_from_float": "write a whole number",
+    "greater_than": "write a larger number",
+    "greater_than_equal": "write a larger number",
+    "less_than": "write a smaller number",
+    "less_than_equal": "write a smaller number",
+    "finite_number": "write an ordinary number (not .nan or .inf)",
 }
+_DEFAULT_HINT = "docs/station-format.md explains what this key takes"
 
 
 def _describe(err: Any) -> str:
@@ -57,7 +65,7 @@ def _schema_diagnostics(src: Source, exc: ValidationError) -> list[Diagnostic]:
     for err in exc.errors():
         loc = tuple(p for p in err["loc"] if not (isinstance(p, str) and p.startswith("function-")))
         # pydantic reports the alias for 'from'/'to' tracks; marks are stored under the YAML key, which matches.
-        hint = _HINTS.get(err["type"], "")
+        hint = _HINTS.get(err["type"], _DEFAULT_HINT)
         at_key = err["type"] == "extra_forbidden"
         if err["type"] == "missing":
             loc = loc[:-1]

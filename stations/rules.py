@@ -159,7 +159,8 @@ class _Warner:
                 ta = j.tuning_area_m or self.r.tuning_area_m
                 if abs(ta - self.r.tuning_area_m) > self.r.tuning_area_tolerance_m:
                     self.warn(self.loc("joints", j.id, "tuning_area_m"), f"tuning area of joint '{j.id}' is {ta:g} m "
-                              f"(standard {self.r.tuning_area_m:g} m)", "")
+                              f"(standard {self.r.tuning_area_m:g} m, tolerance {self.r.tuning_area_tolerance_m:g} m)",
+                              "check the positions of the two tuning units")
 
     def lengths(self) -> None:
         for s in self.st.model.sections:
@@ -170,7 +171,8 @@ class _Warner:
             if (s.type is CircuitType.zpw2000a and length > self.r.capacitor_min_section_m
                     and (s.capacitors is None or s.capacitors.count == 0)):
                 self.warn(self.loc("sections", s.id), f"ZPW-2000A section '{s.id}' is {length:.0f} m long but has no "
-                          "compensation capacitors", "add 'capacitors: {rule: standard}'")
+                          f"compensation capacitors (needed over {self.r.capacitor_min_section_m:g} m)",
+                          "add 'capacitors: {rule: standard}'")
 
 
 def design_warnings(station: Station) -> list[Diagnostic]:

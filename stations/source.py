@@ -104,6 +104,8 @@ def _build(node: yaml.Node, loc: Loc, src: Source, errors: list[Diagnostic]) -> 
                                          f"a key must be a name, not {type(key).__name__}",
                                          "write keys as plain words such as 'id:'"))
                 continue
+            if isinstance(key, bool | int):  # as the JSON the schema sees ('true', '12'), so marks match its locs
+                key = str(key).lower() if isinstance(key, bool) else str(key)
             if key in result:
                 errors.append(Diagnostic(src.file, key_node.start_mark.line + 1,
                                          key_node.start_mark.column + 1,
@@ -127,6 +129,12 @@ def read_yaml(text: str, file: str) -> Source:
         mark = exc.problem_mark or exc.context_mark
         line, col = (mark.line + 1, mark.column + 1) if mark else (1, 1)
         problem = exc.problem or exc.context or "invalid YAML"
+        cm = exc.context_mark
+        if exc.problem and exc.context and cm is not None and mark is not None and cm.line != mark.line:
+            problem += f" ({exc.context} at line {cm.line + 1}, column {cm.column + 1})"
+        bad_line = text.split("\n")[mark.line] if mark is not None and mark.line <= text.count("\n") else ""
+        if mark is not None and bad_line[mark.column:mark.column + 1] == "\t":
+            problem += " (a tab: indent YAML with spaces)"
         raise StationError([Diagnostic(file, line, col, f"YAML syntax error: {problem}",
                                        "check indentation, colons and quotes around this line")]) from None
     except yaml.YAMLError as exc:
