@@ -266,7 +266,7 @@ class Side(StrEnum):
 
 
 class ScreenDoors(Strict):
-    """Platform screen doors (站台门) on one side of a platform track."""
+    """Platform screen doors (站台门) on one side of a platform track; ``side`` is seen facing the down direction."""
 
     side: Side
     doors: Annotated[int, Field(ge=1, le=64)] = 8
