@@ -117,7 +117,7 @@ def _build(node: yaml.Node, loc: Loc, src: Source, errors: list[Diagnostic]) -> 
         return result
     if isinstance(node, yaml.SequenceNode):
         return [_build(item, (*loc, i), src, errors) for i, item in enumerate(node.value)]
-    return _scalar_constructor.construct_object(node, deep=True)  # type: ignore[no-untyped-call]
+    return _scalar_constructor.construct_object(node, deep=True)
 
 
 def read_yaml(text: str, file: str) -> Source:
