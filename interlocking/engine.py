@@ -502,9 +502,10 @@ class Engine:
                 if is_open(self.out.signals.get(sig, "")):
                     continue
                 owner = self.section_lock.get(sec)
-                if (owner is not None and owner in self.routes and owner != self.by_signal.get(sig)
-                        and self.routes[owner].route.direction is not self.station.signals[sig].direction):
-                    continue  # a movement from the other side, in its own route
+                passing = self.routes.get(owner) if owner is not None and owner != self.by_signal.get(sig) else None
+                if passing is not None and (passing.route.direction is not self.station.signals[sig].direction
+                                            or self.station.signals[sig].at in passing.route.path.joints):
+                    continue  # a movement from the other side, or one running past a signal inside its own route
                 rear = self.station.signal_rear_track(sig)
                 if rear is None or self.clear(self.station.tracks[rear].section):
                     continue
