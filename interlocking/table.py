@@ -108,12 +108,18 @@ class InterlockingTable:
     throats: dict[str, tuple[str, ...]]  # throat name (its home signals) -> turnouts
     unselectable: list[str] = field(default_factory=list)  # paths with no distinguishing via button
 
+    _buttons: dict[tuple[str, str, str, tuple[str, ...]], Route] = field(default_factory=dict, init=False,
+                                                                         repr=False, compare=False)
+
     def by_buttons(self, kind: Kind, start: str, end: str, via: Iterable[str] = ()) -> Route | None:
-        via = tuple(via)
-        for r in self.routes.values():
-            if r.kind == kind and r.start == start and r.end == end and r.via == via:
-                return r
-        return None
+        key = (kind, start, end, tuple(via))
+        r = self._buttons.get(key)
+        if r is None or self.routes.get(r.id) is not r:  # first use, or the routes were edited: index again
+            self._buttons.clear()
+            for x in self.routes.values():
+                self._buttons.setdefault((x.kind, x.start, x.end, x.via), x)
+            r = self._buttons.get(key)
+        return r
 
     def as_dict(self) -> dict[str, object]:
         return {"station": self.station.id, "routes": [r.as_dict() for r in self.routes.values()],
@@ -148,13 +154,12 @@ class _Builder:
         d = sig.direction
         out: list[tuple[str, Path, str | None]] = []
         first: Move = self.topo.start_move(sig.at, d)
-        # depth-first over moves; each stack item is the list of moves so far
-        stack: list[list[Move]] = [[first]]
+        # depth-first over moves; each stack item is the list of moves so far and their length
+        stack: list[tuple[list[Move], float]] = [([first], self.st.track_length(first[0]))]
         while stack:
-            moves = stack.pop()
+            moves, length = stack.pop()
             last = moves[-1]
             node = self.topo.far_node(last)
-            length = sum(self.st.track_length(t) for t, _ in moves)
             stop = False
             if kind == "train":
                 end = self._train_end(node, d)
@@ -182,7 +187,7 @@ class _Builder:
                         and self.st.is_station_track(self.st.tracks[last[0]].section) is False \
                         and self._has_shunt_end(node):
                     continue  # a shunting route ends where it enters a station track
-                stack.append([*moves, nxt])
+                stack.append(([*moves, nxt], length + self.st.track_length(nxt[0])))
         return out
 
     def _has_shunt_end(self, node: str) -> bool:
@@ -259,7 +264,7 @@ class _Builder:
                 if kind == "train" and sig.kind not in (SignalKind.home, SignalKind.starting, SignalKind.route):
                     continue
                 grouped: dict[str, list[tuple[Path, str | None]]] = defaultdict(list)
-                for end, path, end_signal in self._walk_routes(sig.id, kind):  # type: ignore[arg-type]
+                for end, path, end_signal in self._walk_routes(sig.id, kind):
                     grouped[end].append((path, end_signal))
                 for end, paths in grouped.items():
                     paths.sort(key=lambda pe: (sum(p is TurnoutPosition.reverse for _, p in pe[0].turnouts),
@@ -304,7 +309,8 @@ class _Builder:
              end_signal: str | None, overlaps: dict[str, object]) -> None:
         st = self.st
         rid = f"{start}-{end}" + (f"({','.join(via)})" if via else "")
-        if kind == "shunt" and any(r.id == rid and r.kind == "train" for r in routes.values()):
+        same = routes.get(rid)
+        if kind == "shunt" and same is not None and same.kind == "train":
             rid = f"{rid}/D"
         turnouts = [RouteTurnout(t, p, "route") for t, p in path.turnouts]
         prot, fouling = self._flank(path)
@@ -446,23 +452,39 @@ def _conflicts(routes: dict[str, Route]) -> None:
     for r in routes.values():
         for s in r.all_sections:
             by_section[s].add(r.id)
-        for t in r.all_turnouts:
-            by_turnout[(t.id, t.position)].add(r.id)
+        for rt in r.all_turnouts:
+            by_turnout[(rt.id, rt.position)].add(r.id)
+    # The first reason found for a pair wins, as with setdefault; the new partners of each route are added in bulk
+    # (a hub has millions of conflicting pairs, so no Python-level work per pair and shared section).
     for sec, ids in by_section.items():
+        why = f"section {sec}"
         for a in ids:
-            for b in ids:
-                if a != b:
-                    routes[a].conflicts.setdefault(b, f"section {sec}")
+            c = routes[a].conflicts
+            new = ids - c.keys()
+            if new:
+                c.update(dict.fromkeys(new, why))
+    for r in routes.values():
+        r.conflicts.pop(r.id, None)  # added with its own sections above
     for (t, pos), ids in by_turnout.items():
         other = TurnoutPosition.reverse if pos is TurnoutPosition.normal else TurnoutPosition.normal
+        opposite = by_turnout.get((t, other))
+        if not opposite:
+            continue
+        why = f"turnout {t} {pos.value}/{other.value}"
         for a in ids:
-            for b in by_turnout.get((t, other), ()):
-                routes[a].conflicts.setdefault(b, f"turnout {t} {pos.value}/{other.value}")
+            c = routes[a].conflicts
+            new = opposite - c.keys()
+            if new:
+                c.update(dict.fromkeys(new, why))
+    trains: dict[Direction, set[str]] = {d: set() for d in Direction}
     for r in routes.values():
-        r.opposing = tuple(sorted(
-            o for o, why in r.conflicts.items()
-            if routes[o].direction is not r.direction and why.startswith("section")
-            and routes[o].kind == "train" and r.kind == "train"))
+        if r.kind == "train":
+            trains[r.direction].add(r.id)
+    for r in routes.values():
+        if r.kind != "train":
+            continue
+        against = trains[Direction.up if r.direction is Direction.down else Direction.down]
+        r.opposing = tuple(sorted(o for o, why in r.conflicts.items() if o in against and why.startswith("section")))
 
 
 def build_table(station: Station) -> InterlockingTable:

@@ -110,6 +110,12 @@ def cmd_run_default(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_bench(args: argparse.Namespace) -> int:
+    from .bench import main as bench_main
+
+    return bench_main(quick=args.quick, fmt=args.format)
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="liansuo", description="Station signalling and interlocking simulator (联锁)")
     sub = p.add_subparsers(dest="command", metavar="COMMAND")
@@ -133,6 +139,9 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("-v", "--verbose", action="store_true", help="print every step of failing tests")
     sp.add_argument("--junit-xml", metavar="FILE", help="also write a JUnit XML report")
     add("run-default", cmd_run_default, "load the default station headless and print its state")
+    sp = add("bench", cmd_bench, "benchmark table building and the interlocking cycle (hub and jiaopei)")
+    sp.add_argument("--quick", action="store_true", help="fewer cycles (under a minute)")
+    sp.add_argument("--format", choices=("json", "text"), default="json")
     return p
 
 

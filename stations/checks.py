@@ -147,14 +147,13 @@ class _Checker:
                 self.err(("turnouts", k, "at"),
                          f"turnout {t.id}: the point leg leaves on the same side as the normal and reverse legs",
                          "the point leg goes one way from the turnout, the normal and reverse legs the other")
+        far_ends: dict[str, list[float]] = {}  # node -> positions of the far ends of its tracks
+        for _, _, a, b in self._track_ports():
+            far_ends.setdefault(a.node, []).append(pos[b.node])
+            if b.node != a.node:
+                far_ends.setdefault(b.node, []).append(pos[a.node])
         for k, j in enumerate(self.m.joints):
-            tracks_here = [tr for tr in self.m.tracks
-                           if parse_port(tr.start).node == j.id or parse_port(tr.end).node == j.id]
-            positions = []
-            for tr in tracks_here:
-                a, b = parse_port(tr.start), parse_port(tr.end)
-                positions.append(pos[b.node] if a.node == j.id else pos[a.node])
-            sides = {p > j.at for p in positions}
+            sides = {p > j.at for p in far_ends.get(j.id, [])}
             if len(sides) != 2:
                 self.err(("joints", k, "at"), f"joint '{j.id}': both its tracks leave on the same side of {j.at:g} m",
                          "a joint lies between its two tracks; check the positions")

@@ -1,0 +1,101 @@
+"""The benchmark and its generated hub station: every figure is there and sensible. Timings are never asserted."""
+
+from __future__ import annotations
+
+import json
+import math
+from collections import Counter
+
+import pytest
+
+from interlocking.table import build_table
+from simulation import bench
+from simulation.bench import Sizes, all_finite, as_text, busy_routes, run_bench
+from simulation.cli import main
+from simulation.hubgen import generate_hub
+from simulation.sim import Simulation
+from stations.loader import load_text
+
+STATION_KEYS = {
+    "station", "turnouts", "sections", "signals", "routes", "load_s", "table_build_s", "conflicting_pairs",
+    "idle_cycles", "cycle_us_idle", "realtime_factor_idle", "busy_routes", "busy_route_ids", "busy_warmup_cycles",
+    "busy_cycles", "cycle_us_busy", "realtime_factor", "busy_route_settings", "busy_traversals", "busy_stalls",
+    "alarms", "peak_memory_mb",
+}
+POSITIVE = ("turnouts", "sections", "routes", "load_s", "table_build_s", "cycle_us_idle", "cycle_us_busy",
+            "realtime_factor", "realtime_factor_idle", "busy_routes", "busy_traversals", "peak_memory_mb")
+
+
+@pytest.fixture(scope="module")
+def report() -> dict[str, object]:
+    return run_bench(Sizes.tiny())
+
+
+def test_report_has_every_figure_positive_and_finite(report: dict[str, object]) -> None:
+    assert json.loads(json.dumps(report)) == report  # plain JSON
+    assert all_finite(report)
+    machine = report["machine"]
+    assert isinstance(machine, dict)
+    assert {"processor", "cpu_count", "python"} <= machine.keys()
+    results = report["results"]
+    assert isinstance(results, dict)
+    assert set(results) == {"hub", "jiaopei"}
+    for res in results.values():
+        assert res.keys() >= STATION_KEYS
+        for key in POSITIVE:
+            assert isinstance(res[key], int | float) and res[key] > 0 and math.isfinite(res[key]), (key, res[key])
+        assert res["busy_stalls"] == 0  # every route opened and released as the traversal expected
+        assert res["alarms"] == 0
+    assert results["hub"]["turnouts"] == 20
+    assert results["jiaopei"]["busy_routes"] == 2  # one train route into each end of the single-line station
+    targets = report["targets"]
+    assert isinstance(targets, list)
+    assert {(t["station"], t["figure"]) for t in targets} >= {("jiaopei", "realtime_factor"),
+                                                              ("hub20", "table_build_s")}
+
+
+def test_text_format_lists_every_station(report: dict[str, object]) -> None:
+    text = as_text(report)
+    assert "hub20" in text and "jiaopei" in text and "cycle busy (us)" in text
+
+
+def test_cli_bench_prints_json(monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
+    monkeypatch.setattr(bench, "run_bench", lambda quick=False: run_bench(Sizes.tiny(), quick=quick))
+    assert main(["bench", "--quick"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["mode"] == "quick" and set(out["results"]) == {"hub", "jiaopei"}
+    assert main(["bench", "--quick", "--format", "text"]) == 0
+    assert "targets:" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(("turnouts", "tracks"), [(0, 1), (6, 4), (20, 8), (61, 24)])
+def test_generated_hub_is_valid_and_exact(turnouts: int, tracks: int) -> None:
+    station = load_text(generate_hub(turnouts, tracks), "<hub>")
+    assert station.warnings == []
+    assert len(station.turnouts) == turnouts
+    assert sum(s.role.value == "station_track" for s in station.sections.values()) == tracks
+    table = build_table(station)
+    kinds = Counter(r.category for r in table.routes.values())
+    assert kinds["receiving"] >= 2 * tracks and kinds["departure"] >= 2 * tracks and kinds["shunting"] > 0
+    assert table.unselectable == []
+
+
+def test_hub_200_gives_hundreds_of_routes_and_holds_20_at_once() -> None:
+    station = load_text(generate_hub(200, 80), "<hub200>")
+    assert station.warnings == []
+    table = build_table(station)
+    assert len(table.routes) >= 500
+    routes = busy_routes(table, 20)
+    assert len(routes) == 20
+    sim = Simulation(station, table=table)
+    for r in routes:
+        assert sim.command(f"route {r.start} {r.end}").ok
+    sim.run(60)
+    assert all(sim.route_state(r.id) == "open" for r in routes)
+
+
+def test_impossible_hub_is_refused() -> None:
+    with pytest.raises(ValueError, match="at least"):
+        generate_hub(5, 4)
+    with pytest.raises(ValueError, match="cannot be laid out"):
+        generate_hub(30, 4)
