@@ -90,6 +90,8 @@ class Engine:
     def cycle(self, t: float) -> Outputs:
         self.now = t
         self.cycles += 1
+        self.out.changed_signals.clear()  # from here on: what this cycle changed
+        self.out.changed_turnouts.clear()
         tracks, turnouts, signals, doors, pulses = self.board.take_changes()
         if tracks:
             self._check_spad(tracks)
@@ -351,6 +353,7 @@ class Engine:
                 return  # a shunting signal stays open until the whole consist is past it
             self.close_signal(rs, f"train entered {r.sections[0]}", abnormal=False)
             rs.stage = RouteStage.in_use
+            self.codes_dirty = True
             self._sequential_release(rs)
             return
         blocker = self.open_blocker(rs)
@@ -426,6 +429,7 @@ class Engine:
     def _release_section(self, rs: RouteState, i: int) -> None:
         s = rs.route.sections[i]
         rs.released[i] = True
+        self.codes_dirty = True
         if self.section_lock.get(s) == rs.id:
             del self.section_lock[s]
         for t in rs.route.turnouts:
@@ -574,13 +578,22 @@ class Engine:
         return out
 
     def _update_block_signals(self) -> None:
-        for sig, sections, nxt in self._block_signals:
-            if any(not self.clear(s) for s in sections):
-                aspect = "H"
-            else:
-                ahead = self.out.signals.get(nxt, "L") if nxt else "L"
-                aspect = {"H": "U", "A": "U", "": "U", "U": "LU", "UU": "U"}.get(ahead, "L")
-            self.out.set_aspect(sig, self._proven(sig, aspect) if aspect != "H" else "H")
+        """Four-aspect automatic block: each signal follows its own sections and the signal ahead. The chain is
+        evaluated until it settles, so a change at one end reaches the other within the cycle."""
+        for _ in range(len(self._block_signals) + 1):
+            changed = False
+            for sig, sections, nxt in self._block_signals:
+                if any(not self.clear(s) for s in sections):
+                    aspect = "H"
+                else:
+                    ahead = self.out.signals.get(nxt, "L") if nxt else "L"
+                    aspect = {"H": "U", "A": "U", "": "U", "U": "LU", "UU": "U"}.get(ahead, "L")
+                shown = self._proven(sig, aspect) if aspect != "H" else "H"
+                if self.out.signals.get(sig) != shown:
+                    self.out.set_aspect(sig, shown)
+                    changed = True
+            if not changed:
+                return
 
     def _update_cab_codes(self) -> None:
         self.codes_dirty = False
