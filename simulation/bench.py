@@ -12,6 +12,9 @@ For each station:
   driver occupies each route's approach and sections in order and vacates them behind (``field.occupy/vacate``, the
   teaching base's switch K), and sets the route again once it has released;
 * ``realtime_factor``: simulated seconds per wall second over the busy run, driver and route commands included.
+
+And once, station-independent: ``zpw_configs_per_s``, ZPW-2000A section configurations (carrier x ballast x
+capacitor fault x shunt position) evaluated per second by the vectorised sweep of ``circuits.zpw2000a``.
 """
 
 from __future__ import annotations
@@ -44,6 +47,8 @@ TARGETS: dict[str, list[tuple[str, str, float]]] = {
     "hub": [("table_build_s", "<=", 5.0), ("cycle_us_busy", "<=", 1000.0), ("realtime_factor", ">=", 250.0)],
     "jiaopei": [("realtime_factor", ">=", 5000.0)],
 }
+ZPW_TARGET_CONFIGS_PER_S = 100_000.0
+ZPW_BALLASTS = (1.0, 1.5, 2.0, 3.0, 5.0, 10.0)  # ohm*km
 
 
 @dataclass(frozen=True)
@@ -57,15 +62,16 @@ class Sizes:
     small_factor: int = 5  # jiaopei runs this many times more cycles (each is much cheaper)
     busy_routes: int = BUSY_ROUTES
     warmup_limit: int = 2400  # cycles allowed for the busy routes to be set and opened once
+    zpw_repeats: int = 10  # vectorised ZPW-2000A sweeps timed
 
     @staticmethod
     def quick() -> Sizes:
-        return Sizes(idle_cycles=1000, busy_cycles=2400)
+        return Sizes(idle_cycles=1000, busy_cycles=2400, zpw_repeats=3)
 
     @staticmethod
     def tiny() -> Sizes:
         return Sizes(hub_turnouts=20, hub_tracks=8, idle_cycles=20, busy_cycles=120, small_factor=1,
-                     warmup_limit=400)
+                     warmup_limit=400, zpw_repeats=1)
 
 
 def _peak_rss_mb() -> float:
@@ -279,6 +285,39 @@ def measure(station_source: str, *, label: str, text: bool, idle_cycles: int, bu
     return out
 
 
+def measure_zpw(repeats: int = 10, length_m: float = 1400.0) -> dict[str, Any]:
+    """``zpw_configs_per_s``: one sweep of a ``length_m`` section with standard capacitors over every carrier (8),
+    ``ZPW_BALLASTS``, no fault plus every single capacitor fault (open, -50 %, short) and a 0.15 ohm shunt every
+    10 m; a configuration is one (carrier, ballast, fault case, shunt position): receiver voltage and cab current."""
+    from circuits.zpw2000a import ZpwCircuit, standard_positions, sweep
+
+    sweep([length_m], ballasts=ZPW_BALLASTS)  # warm-up
+    gc.collect()
+    t0 = time.perf_counter()
+    for _ in range(repeats):
+        result = sweep([length_m], ballasts=ZPW_BALLASTS)[0]
+    elapsed = time.perf_counter() - t0
+    configs = result.configurations
+    # the live simulation's call: one section, one shunt (a moving wheelset) or a 64-axle train
+    circuit = ZpwCircuit(length_m, "2600-1", standard_positions(length_m))
+    calls = 200 * repeats
+    t1 = time.perf_counter()
+    for k in range(calls):
+        circuit.evaluate([(k * 7.0 % length_m, 0.15)])
+    t2 = time.perf_counter()
+    for k in range(calls // 10):
+        circuit.evaluate([(k % 500 + 2.5 * axle, 0.15) for axle in range(64)])
+    t3 = time.perf_counter()
+    return {
+        "evaluate_us_one_shunt": round((t2 - t1) / calls * 1e6, 1),
+        "evaluate_us_train64": round((t3 - t2) / (calls // 10) * 1e6, 1),
+        "length_m": length_m, "carriers": len(result.carriers), "ballasts": len(result.ballasts_ohm_km),
+        "fault_cases": len(result.faults), "shunt_positions": len(result.positions_m),
+        "configurations": configs, "sweeps": repeats, "sweep_s": round(elapsed / repeats, 5),
+        "zpw_configs_per_s": round(configs * repeats / elapsed, 1),
+    }
+
+
 def _check_targets(results: dict[str, dict[str, Any]]) -> list[dict[str, Any]]:
     checks = []
     for key, targets in TARGETS.items():
@@ -310,13 +349,18 @@ def run_bench(sizes: Sizes | None = None, *, quick: bool = False, stations: tupl
             results[key] = measure(key, label=key, text=False, idle_cycles=sizes.idle_cycles * sizes.small_factor,
                                    busy_cycles=sizes.busy_cycles * sizes.small_factor,
                                    routes_limit=sizes.busy_routes, warmup_limit=sizes.warmup_limit)
+    zpw = measure_zpw(sizes.zpw_repeats)
+    targets = _check_targets(results)
+    targets.append({"station": "zpw", "figure": "zpw_configs_per_s", "target": f">= {ZPW_TARGET_CONFIGS_PER_S:g}",
+                    "value": zpw["zpw_configs_per_s"], "met": zpw["zpw_configs_per_s"] >= ZPW_TARGET_CONFIGS_PER_S})
     return {
         "benchmark": "liansuo bench",
         "mode": "quick" if quick else ("custom" if sizes != Sizes() else "full"),
         "machine": machine(),
         "cycle_s": 0.25,
         "results": results,
-        "targets": _check_targets(results),
+        "zpw": zpw,
+        "targets": targets,
         "total_s": round(time.perf_counter() - start, 2),
     }
 
@@ -352,6 +396,11 @@ def as_text(report: dict[str, Any]) -> str:
     lines.append(f"{'':26}" + "".join(f"{results[k]['station']:>14}" for k in keys))
     for field, title, fmt in _TEXT_ROWS:
         lines.append(f"{title:26}" + "".join(f"{fmt.format(results[k][field]):>14}" for k in keys))
+    z = report.get("zpw")
+    if z:
+        lines.append(f"{'zpw configs/s':26}{z['zpw_configs_per_s']:>14.0f}  ({z['configurations']} per sweep of "
+                     f"{z['sweep_s'] * 1000:.1f} ms; evaluate {z['evaluate_us_one_shunt']:.0f} us, 64-axle train "
+                     f"{z['evaluate_us_train64']:.0f} us)")
     lines.append("targets:")
     for t in report["targets"]:
         lines.append(f"  {t['station']:10} {t['figure']:16} {t['target']:>8}  measured {t['value']:g}  "

@@ -142,6 +142,9 @@ def build_parser() -> argparse.ArgumentParser:
     sp = add("bench", cmd_bench, "benchmark table building and the interlocking cycle (hub and jiaopei)")
     sp.add_argument("--quick", action="store_true", help="fewer cycles (under a minute)")
     sp.add_argument("--format", choices=("json", "text"), default="json")
+    from .zpwcli import register as register_zpw
+
+    register_zpw(add)
     return p
 
 
