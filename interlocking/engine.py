@@ -56,6 +56,7 @@ class Engine:
         self.moving: set[str] = set()
         self.no_indication: set[str] = set(st.turnouts)  # fail-safe: nothing reported yet
         self.guide_locked: set[str] = set()
+        self.usu_failed: set[str] = set()  # flasher check failed while showing USU: UU until the route releases
         self.guide_only: dict[str, float] = {}  # guide aspect without a route (throat under guide total lock)
         self.guide_seen: dict[str, bool] = {}
         self.events: deque[Event] = deque(maxlen=MAX_EVENTS)
@@ -130,10 +131,17 @@ class Engine:
         sig = self.station.signals[signal]
         if sig.usu:
             if self.board.flasher_ok(signal):
-                self.clear_alarm(f"flasher:{signal}")
+                if signal not in self.usu_failed:
+                    self.clear_alarm(f"flasher:{signal}")
             else:
+                self.usu_failed.add(signal)
                 self.alarm(f"flasher:{signal}", f"signal {signal}: USU flasher failed (SNJ/SNJJ down); USU "
                            "degrades to UU")
+        if self.board.filament_alarm.get(signal, False):
+            self.alarm(f"filament:{signal}", f"signal {signal}: main filament broken (主丝断丝), lamp on its backup "
+                       "filament or dark")
+        else:
+            self.clear_alarm(f"filament:{signal}")
         stop = "A" if sig.kind is SignalKind.shunting else "H"
         if stop in [lamp.value for lamp in sig.lamps]:
             dark = not self.board.lamp_ok(signal, stop)
@@ -304,7 +312,8 @@ class Engine:
         r = rs.route
         next_aspect = self.out.signals.get(r.end_signal, "") if r.end_signal else ""
         clear_blocks = self._clear_blocks(r.exit_link) if r.exit_link in self.auto_links else None
-        usu_ready = bool(r.end_signal) and is_open(next_aspect) and self.board.flasher_ok(r.signal)
+        usu_ready = (bool(r.end_signal) and is_open(next_aspect) and self.board.flasher_ok(r.signal)
+                     and r.signal not in self.usu_failed)
         return select_aspect(self.station, r, next_aspect, clear_blocks, usu_ready, self.rules)
 
     def _proven(self, signal: str, aspect: str) -> str:
@@ -346,6 +355,10 @@ class Engine:
         r = rs.route
         if rs.guide:
             self._keep_guide(rs)
+            return
+        if not self.clear(r.sections[0]) and r.approach and all(self.clear(s) for s in r.approach):
+            # occupied with nobody approaching: a track-circuit fault (red band), not a train entering
+            self.close_signal(rs, f"section {r.sections[0]} is occupied", abnormal=True)
             return
         if not self.clear(r.sections[0]):
             rs.entered = True
@@ -459,6 +472,7 @@ class Engine:
         if self.out.signals.get(r.signal) != stop_aspect(self.station, r.signal):
             self.out.set_aspect(r.signal, stop_aspect(self.station, r.signal))
         self.signals[r.signal].route = None
+        self.usu_failed.discard(r.signal)
         self.routes.pop(rs.id, None)
         if self.by_signal.get(r.signal) == rs.id:
             del self.by_signal[r.signal]

@@ -35,6 +35,7 @@ class RelayBoard:
     fbj: dict[str, bool] = field(default_factory=dict)  # turnout -> reverse indication
     lamps: dict[str, dict[str, bool]] = field(default_factory=dict)  # signal -> lamp -> DJ proven
     flasher: dict[str, bool] = field(default_factory=dict)  # signal -> SNJ/SNJJ healthy
+    filament_alarm: dict[str, bool] = field(default_factory=dict)  # signal -> a main filament broken
     pdkj: dict[str, bool] = field(default_factory=dict)  # platform:side -> doors closed and locked
     pdqcj: dict[str, bool] = field(default_factory=dict)  # platform:side -> interlock bypass
     line_in: dict[str, set[str]] = field(default_factory=dict)  # link -> pulses received this cycle
@@ -64,6 +65,11 @@ class RelayBoard:
     def set_flasher(self, signal: str, healthy: bool) -> None:
         if self.flasher.get(signal) is not healthy:
             self.flasher[signal] = healthy
+            self.changed_signals.add(signal)
+
+    def set_filament_alarm(self, signal: str, alarm: bool) -> None:
+        if self.filament_alarm.get(signal, False) is not alarm:
+            self.filament_alarm[signal] = alarm
             self.changed_signals.add(signal)
 
     def set_doors(self, key: str, closed_locked: bool, bypass: bool) -> None:

@@ -12,6 +12,7 @@ from __future__ import annotations
 from collections import defaultdict
 from collections.abc import Iterable
 from dataclasses import dataclass, field
+from itertools import pairwise
 from typing import Literal
 
 from stations.schema import Button, Direction, SectionRole, SignalKind, TurnoutPosition
@@ -196,7 +197,7 @@ class _Builder:
     def _path(self, start: str, d: Direction, moves: list[Move]) -> Path:
         turnouts: list[tuple[str, TurnoutPosition]] = []
         joints: list[str] = []
-        for a, b in zip(moves, moves[1:], strict=False):
+        for a, b in pairwise(moves):
             data = self.topo.graph.edges[a, b]
             if data["turnout"] is not None:
                 turnouts.append((str(data["turnout"]), TurnoutPosition(str(data["position"]))))

@@ -37,6 +37,10 @@ USAGE = {
     "block-line": "block-line LINK request|accept|cancel|restore|accident",
     "neighbour": "neighbour LINK request|depart|restore|accident",
     "doors": "doors PLATFORM open|close",
+    "fault": "fault KIND TARGET [key=value ...]",
+    "repair": "repair KIND TARGET",
+    "faults": "faults",
+    "axles": "axles NAME TRACK POSITION [POSITION ...] | axles NAME clear",
     "occupy": "occupy SECTION",
     "vacate": "vacate SECTION",
     "run": "run DURATION",
@@ -88,6 +92,69 @@ def _vacate(sim: Simulation, section: str) -> Result:
     return Result.accept(f"{section} vacated")
 
 
+def _fault(sim: Simulation, args: list[str]) -> Result:
+    from circuits.faults import KINDS, parse_fault
+
+    if len(args) < 2:
+        return Result.refuse(f"usage: {USAGE['fault']}; kinds: {', '.join(KINDS)}")
+    parsed = parse_fault(sim.station, args[0], args[1], args[2:])
+    if isinstance(parsed, str):
+        return Result.refuse(parsed)
+    if (parsed.kind, parsed.target) in sim.field.faults:
+        return Result.refuse(f"{parsed.kind} on {parsed.target} is already active; repair it first")
+    why = sim.field.inject(parsed)
+    if why:
+        return Result.refuse(f"fault {parsed.kind}: {why}")
+    sim.interlocking.event("fault", f"fault injected: {parsed.describe()}")
+    return Result.accept(f"fault injected: {parsed.describe()}")
+
+
+def _repair(sim: Simulation, args: list[str]) -> Result:
+    if len(args) != 2:
+        return Result.refuse(f"usage: {USAGE['repair']}")
+    why = sim.field.repair(args[0], args[1])
+    if why:
+        return Result.refuse(why)
+    sim.interlocking.event("fault", f"repaired: {args[0]} {args[1]}")
+    return Result.accept(f"repaired: {args[0]} {args[1]}")
+
+
+def _faults(sim: Simulation, args: list[str]) -> Result:
+    active = [f.describe() for f in sim.field.faults.values()]
+    return Result.accept("; ".join(active) if active else "no active faults")
+
+
+def _axles(sim: Simulation, args: list[str]) -> Result:
+    """Wheelsets standing on a track at positions along the line: each shunts its section unless in a dead zone."""
+    from circuits.railgeometry import Axle
+
+    if len(args) == 2 and args[1] == "clear":
+        if args[0] not in sim.parked:
+            return Result.refuse(f"no wheelsets named '{args[0]}' are on the track")
+        sim.place_axles(args[0], [])
+        return Result.accept(f"wheelsets {args[0]} removed")
+    if len(args) < 3:
+        return Result.refuse(f"usage: {USAGE['axles']}")
+    name, track, *positions = args
+    if track not in sim.station.tracks:
+        return Result.refuse(f"there is no track '{track}' at {sim.station.id}")
+    lo, hi = sim.station.track_span(track)
+    axles = []
+    for p in positions:
+        try:
+            x = float(p)
+        except ValueError:
+            return Result.refuse(f"'{p}' is not a position in metres")
+        if not lo <= x <= hi:
+            return Result.refuse(f"position {x:g} m is off track {track} ({lo:g}-{hi:g} m)")
+        axles.append(Axle(track, x))
+    sim.place_axles(name, axles)
+    shunting = sorted({s.section for a in axles if (s := sim.field.geometry.shunt(a)) is not None})
+    hidden = sum(sim.field.geometry.shunt(a) is None for a in axles)
+    note = f"; {hidden} in dead zones" if hidden else ""
+    return Result.accept(f"{len(axles)} wheelsets {name} on {track}, shunting {', '.join(shunting) or 'nothing'}{note}")
+
+
 def _run(sim: Simulation, args: list[str]) -> Result:
     if len(args) != 1:
         return Result.refuse(f"usage: {USAGE['run']}")
@@ -111,11 +178,11 @@ def _neighbour(sim: Simulation, args: list[str]) -> Result:
     if len(args) != 2:
         return Result.refuse(f"usage: {USAGE['neighbour']}")
     link, action = args
-    if link not in sim.field.neighbours:
+    if link not in sim.neighbours.by_link:
         return Result.refuse(f"there is no virtual neighbour on block line '{link}'")
     if action not in ("request", "depart", "restore", "accident"):
         return Result.refuse(f"usage: {USAGE['neighbour']}")
-    sim.field.neighbour_sends(link, action)
+    sim.neighbours.send(link, action)
     return Result.accept(f"neighbour on {link}: {action}")
 
 
@@ -209,6 +276,10 @@ COMMANDS: dict[str, Handler] = {
     "block-line": _block_line,
     "neighbour": _neighbour,
     "doors": _doors,
+    "fault": _fault,
+    "repair": _repair,
+    "faults": _faults,
+    "axles": _axles,
     "occupy": _one("occupy", _occupy),
     "vacate": _one("vacate", _vacate),
     "run": _run,

@@ -8,6 +8,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from circuits.field import Field
+from circuits.railgeometry import Axle
 from interlocking.io import Result
 from interlocking.operations import Interlocking
 from interlocking.rules import RuleSet, load_rules
@@ -16,7 +18,8 @@ from interlocking.table import InterlockingTable, build_table
 from stations.loader import load
 from stations.station import Station
 
-from .field import IdealField
+from .neighbour import Neighbours
+from .wiring import Wiring
 
 
 class Simulation:
@@ -27,18 +30,36 @@ class Simulation:
         self.table = table or build_table(self.station)
         self.cycle_s = cycle_s
         self.interlocking: Interlocking = Interlocking(self.table, self.rules, cycle_s)
-        self.field: IdealField = IdealField(self.station, self.rules)
+        self.field: Field = Field(self.station)
+        self.wiring = Wiring(self.station, self.rules, self.field)
+        self.neighbours = Neighbours(self.station, self.rules.block_pulse_s)
         self.t = 0.0
         self.last_result: Result | None = None
-        self.field.publish(self.interlocking.board)
+        self.parked: dict[str, list[Axle]] = {}  # named sets of wheelsets placed by hand (``axles`` command)
+        self.wiring.publish(self.interlocking.board, everything=True)
         self.interlocking.cycle(self.t)
 
     # ---- time -------------------------------------------------------------------------------------------------
     def step(self) -> None:
-        self.field.step(self.cycle_s, self.interlocking.out)
+        il = self.interlocking
+        self.field.step(self.cycle_s, self.wiring.commands_from(il.out))
         self.t = round(self.t + self.cycle_s, 9)
-        self.field.publish(self.interlocking.board)
-        self.interlocking.cycle(self.t)
+        self.neighbours.step(self.t, il.out.line_out, self.field.track_up)
+        self.publish()
+        il.cycle(self.t)
+
+    def publish(self) -> None:
+        """Relays follow the field at once; only the interlocking's processing is cyclic."""
+        self.wiring.publish(self.interlocking.board)
+        self.neighbours.publish(self.interlocking.board)
+
+    def place_axles(self, name: str, axles: list[Axle]) -> None:
+        """Stand a named set of wheelsets on the track (replacing that name's earlier ones; [] removes them)."""
+        if axles:
+            self.parked[name] = axles
+        else:
+            self.parked.pop(name, None)
+        self.field.set_axles([a for group in self.parked.values() for a in group])
 
     def run(self, seconds: float) -> None:
         for _ in range(max(0, round(seconds / self.cycle_s))):
@@ -49,10 +70,9 @@ class Simulation:
         """Run one line of the command language; scripts' ``expect`` lines check the state."""
         from .commands import execute
 
-        self.field.publish(self.interlocking.board)
+        self.publish()
         result = execute(self, line)
-        # relays follow the field at once; only the interlocking's processing is cyclic
-        self.field.publish(self.interlocking.board)
+        self.publish()
         if not line.strip().startswith("expect"):
             self.last_result = result
         return result

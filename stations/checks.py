@@ -53,6 +53,7 @@ class _Checker:
         self.signals()
         self.standalone_buttons()
         self.fouling_points()
+        self.markers()
         self.platforms()
         self.links()
         self.overlaps_and_overrides()
@@ -66,6 +67,7 @@ class _Checker:
             ("tracks", self.m.tracks, "track"), ("sections", self.m.sections, "section"),
             ("signals", self.m.signals, "button"), ("buttons", self.m.buttons, "button"),
             ("fouling_points", self.m.fouling_points, "fouling"), ("platforms", self.m.platforms, "platform"),
+            ("markers", self.m.markers, "marker"),
             ("links", self.m.links, "link"),
         ]
         seen: dict[tuple[str, str], str] = {}
@@ -329,6 +331,20 @@ class _Checker:
                          f"fouling point {f.id} at {f.at:g} m is off track '{t.id}' "
                          f"({min(xa, xb):g}-{max(xa, xb):g} m)",
                          "a fouling point lies on its track, between the track's two ends")
+
+    def markers(self) -> None:
+        tracks = {t.id: t for t in self.m.tracks}
+        for k, mk in enumerate(self.m.markers):
+            t = tracks.get(mk.track)
+            if t is None:
+                self.err(("markers", k, "track"), f"marker {mk.id} is on unknown track '{mk.track}'",
+                         "name a track declared under 'tracks:'")
+                continue
+            xa = self.node_positions[parse_port(t.start).node]
+            xb = self.node_positions[parse_port(t.end).node]
+            if not min(xa, xb) <= mk.at <= max(xa, xb):
+                self.err(("markers", k, "at"), f"marker {mk.id} at {mk.at:g} m is off track '{t.id}' "
+                         f"({min(xa, xb):g}-{max(xa, xb):g} m)", "a marker lies on its track, between its two ends")
 
     def platforms(self) -> None:
         sections = {s.id: s for s in self.m.sections}

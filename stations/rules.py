@@ -6,6 +6,7 @@ The numbers come from ``design_rules.yaml``; each warning states the measured fi
 from __future__ import annotations
 
 from functools import cache
+from itertools import pairwise
 from pathlib import Path
 
 import yaml
@@ -35,6 +36,7 @@ class DesignRules(BaseModel):
     capacitor_min_section_m: float
     capacitor_spacing_m: float
     phase25hz_max_length_m: float
+    bogie_wheelbase_min_m: float
 
 
 @cache
@@ -95,6 +97,11 @@ class _Warner:
                 self.warn(self.loc("joints", j.id, "at2"),
                           f"joint '{j.id}': rail joints staggered {dz.length:.2f} m (limit {limit:g} m); the dead zone "
                           "can hide a wheelset", "move one rail's joint to bring the stagger within the limit")
+            if dz.length >= self.r.bogie_wheelbase_min_m:
+                self.warn(self.loc("joints", j.id, "at2"),
+                          f"joint '{j.id}': the {dz.length:.2f} m dead zone can hold a whole bogie (wheelbase from "
+                          f"{self.r.bogie_wheelbase_min_m:g} m): its wheelsets there shunt nothing, so a vehicle can "
+                          "vanish from the interlocking", "shorten the dead zone below the shortest bogie wheelbase")
 
     def spacing(self) -> None:
         zones = {dz.joint: dz for dz in self.st.dead_zones}
@@ -105,7 +112,7 @@ class _Warner:
                     if p.node in zones:
                         bounding.add(p.node)
             ordered = sorted(bounding, key=lambda j: self.st.joints[j].at)
-            for a, b in zip(ordered, ordered[1:], strict=False):
+            for a, b in pairwise(ordered):
                 za, zb = zones[a], zones[b]
                 gap = zb.start - za.end
                 if gap <= 0 or gap >= self.r.dead_zone_spacing_min_m:
@@ -116,7 +123,8 @@ class _Warner:
                 self.warn(self.loc("joints", b, "at"),
                           f"section '{sec}': dead zones at joints '{a}' and '{b}' are only {gap:.1f} m apart "
                           f"(need >= {self.r.dead_zone_spacing_min_m:g} m, or >= "
-                          f"{self.r.dead_zone_spacing_relaxed_m:g} m when both are under {self.r.dead_zone_short_m:g} m)",
+                          f"{self.r.dead_zone_spacing_relaxed_m:g} m when both are under "
+                          f"{self.r.dead_zone_short_m:g} m)",
                           "a short vehicle could stand in both dead zones at once and vanish from the interlocking")
 
     def fouling(self) -> None:
@@ -131,7 +139,8 @@ class _Warner:
                 if -50.0 < d < clearance and abs(d) < 50.0:
                     self.warn(self.loc("fouling_points", fp.id, "at"),
                               f"fouling point {fp.id} is {d:.1f} m ahead of the joint of starting signal {sig.id} "
-                              f"(need >= {clearance:g} m)" + (" : the joint is inside the fouling limit" if d < 0 else ""),
+                              f"(need >= {clearance:g} m)"
+                              + (" : the joint is inside the fouling limit" if d < 0 else ""),
                               "a train stopped at the signal could foul the throat; move the joint or the signal back")
 
     def coding(self) -> None:
@@ -150,11 +159,11 @@ class _Warner:
         for j in self.st.model.joints:
             a, b = self.st.joint_sections(j.id)
             sa, sb = self.st.sections[a], self.st.sections[b]
-            if sa.type is CircuitType.zpw2000a and sb.type is CircuitType.zpw2000a and sa.carrier and sb.carrier:
-                if sa.carrier.split("-")[0] == sb.carrier.split("-")[0]:
-                    self.warn(self.loc("joints", j.id), f"sections '{a}' and '{b}' on both sides of joint '{j.id}' "
-                              f"use the same carrier frequency ({sa.carrier}, {sb.carrier})",
-                              "alternate carriers along a line: 1700/2300 on the down line, 2000/2600 on the up line")
+            if (sa.type is CircuitType.zpw2000a and sb.type is CircuitType.zpw2000a and sa.carrier and sb.carrier
+                    and sa.carrier.split("-")[0] == sb.carrier.split("-")[0]):
+                self.warn(self.loc("joints", j.id), f"sections '{a}' and '{b}' on both sides of joint '{j.id}' "
+                          f"use the same carrier frequency ({sa.carrier}, {sb.carrier})",
+                          "alternate carriers along a line: 1700/2300 on the down line, 2000/2600 on the up line")
             if j.kind is JointKind.electrical:
                 ta = j.tuning_area_m or self.r.tuning_area_m
                 if abs(ta - self.r.tuning_area_m) > self.r.tuning_area_tolerance_m:

@@ -237,6 +237,7 @@ class Signal(Strict):
     direction: Direction
     lamps: list[Lamp] = Field(min_length=1)
     usu: bool = False  # may show the flashing yellow USU (needs a U and a U2 lamp)
+    flasher: Literal["relay", "electronic"] = "electronic"  # USU flasher: classic RC relay (SNJ/SNJJ) or electronic
     buttons: list[Button] = Field(default_factory=list)
     release_s: Annotated[float, Field(gt=0)] | None = None  # manual release delay override
     approach: list[Id] | None = None  # override of the approach section(s) (接近区段)
@@ -258,6 +259,26 @@ class FoulingPoint(Strict):
     id: Id
     track: Id
     at: Position
+
+
+class MarkerKind(StrEnum):
+    sanding = "sanding"  # 上砂点: depot speed limit over it
+    washing = "washing"  # 洗车点
+    one_stop = "one-stop"  # 一度停车点: every movement stops here once
+    balise = "balise"  # 应答器: odometry correction
+    rfid = "rfid"  # RFID tag: odometry correction in the depot
+    stop = "stop"  # 停车标: the stopping point of a platform or a depot track
+
+
+class Marker(Strict):
+    """A trackside point that trains and their drivers see (not the interlocking)."""
+
+    id: Id
+    kind: MarkerKind
+    track: Id
+    at: Position
+    length_m: Annotated[float, Field(ge=0)] = 0.0  # for sanding / washing stretches
+    speed_kmh: Annotated[float, Field(gt=0)] | None = None  # speed limit over it, where it has one
 
 
 class Side(StrEnum):
@@ -347,6 +368,7 @@ class StationFile(Strict):
     signals: list[Signal] = Field(default_factory=list)
     buttons: list[StandaloneButton] = Field(default_factory=list)
     fouling_points: list[FoulingPoint] = Field(default_factory=list)
+    markers: list[Marker] = Field(default_factory=list)
     platforms: list[Platform] = Field(default_factory=list)
     links: list[Link] = Field(default_factory=list)
     overlaps: list[Overlap] = Field(default_factory=list)

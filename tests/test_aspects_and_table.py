@@ -41,21 +41,18 @@ def test_downgrade_order(aspect: str, dark: set[str], shown: str) -> None:
 
 def test_dark_green_on_home_signal_closes_it(jiaopei: Driver) -> None:
     jiaopei("route X XI", "route XI S", "block-line SL request", "run 6s", "expect signal X L")
-    jiaopei.sim.field.set_lamp_dark("X", "L", True)
-    jiaopei("run 1s", "expect signal X H", "expect alarm lamp(s) L dark")
+    jiaopei("fault filament X lamp=L which=both", "run 1s", "expect signal X H", "expect alarm lamp(s) L dark")
 
 
 def test_dark_yellow_closes_the_signal_and_it_stays_closed(jiaopei: Driver) -> None:
     jiaopei("route X XI", "run 1s", "expect signal X U")
-    jiaopei.sim.field.set_lamp_dark("X", "U", True)
-    jiaopei("run 1s", "expect signal X H")
-    jiaopei.sim.field.set_lamp_dark("X", "U", False)
-    jiaopei("run 5s", "expect signal X H", "reopen X", "run 1s", "expect signal X U")
+    jiaopei("fault filament X lamp=U which=both", "run 1s", "expect signal X H", "repair filament X", "run 5s",
+            "expect signal X H", "reopen X", "run 1s", "expect signal X U")
 
 
 def test_red_lamp_transfer_keeps_the_signal_in_rear_closed(jiaopei: Driver) -> None:
-    jiaopei.sim.field.set_lamp_dark("XI", "H", True)
-    jiaopei("run 1s", "expect alarm XI: H lamp dark", "route X XI", "run 1s", "expect signal X H")
+    jiaopei("fault filament XI lamp=H which=both", "run 1s", "expect alarm XI: H lamp dark", "route X XI", "run 1s",
+            "expect signal X H")
 
 
 # ---- table ------------------------------------------------------------------------------------------------------

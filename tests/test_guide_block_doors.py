@@ -25,15 +25,13 @@ def test_guide_route_over_a_faulty_section_shows_red_and_moon_white(jiaopei: Dri
 def test_guide_refused_without_route_or_with_turnout_out_of_position(jiaopei: Driver) -> None:
     jiaopei.refused("guide X", "no route is set from X")
     jiaopei.refused("guide XI", "no guide aspect")
-    jiaopei.sim.field.set_indication_lost("7", True)
-    jiaopei("route X XI", "run 1s")
+    jiaopei("fault no-indication 7", "route X XI", "run 1s")
     jiaopei.refused("guide X", "turnout 7 has no indication")
 
 
 def test_guide_needs_the_red_lamp_lit(jiaopei: Driver) -> None:
     jiaopei("route X XI", "run 1s", "occupy 1DG", "run 1s")
-    jiaopei.sim.field.set_lamp_dark("X", "H", True)
-    jiaopei("run 1s")
+    jiaopei("fault filament X lamp=H which=both", "run 1s")
     jiaopei.refused("guide X", "red lamp of X is dark")
 
 
@@ -74,26 +72,29 @@ def test_64d_accident_button_forces_the_line_back_and_is_counted(jiaopei: Driver
 
 # ---- platform screen doors (gaotie: P3 on 3G, P4 on 4G) -------------------------------------------------------
 def test_signal_onto_platform_track_needs_doors_closed_and_locked_or_bypassed(gaotie: Driver) -> None:
-    gaotie.sim.field.set_doors("P3:left", open_=True)
-    gaotie.sim.field.doors_stuck.add("P3:left")
-    gaotie("route X X3", "run 10s", "expect signal X H", "expect route X X3 locked")
-    gaotie.sim.field.set_doors("P3:left", bypass=True)
-    gaotie("run 1s", "expect signal X UU")
+    gaotie("fault psd-stuck P3", "route X X3", "run 10s", "expect signal X H", "expect route X X3 locked",
+           "fault psd-bypass P3", "run 1s", "expect signal X UU")
 
 
 def test_losing_door_proof_closes_the_departure_signal(gaotie: Driver) -> None:
-    gaotie("route X3 XFCK", "run 10s", "expect signal X3 L")
-    gaotie.sim.field.set_doors("P3:left", open_=True)  # doors spring open (stuck)
-    gaotie.sim.field.doors_stuck.add("P3:left")
-    gaotie("run 1s", "expect signal X3 H", "expect alarm screen doors P3:left")
+    gaotie("route X3 XFCK", "run 10s", "expect signal X3 L", "fault psd-stuck P3", "run 1s", "expect signal X3 H",
+           "expect alarm screen doors P3:left")
 
 
 def test_doors_open_only_with_a_train_at_the_platform(gaotie: Driver) -> None:
     gaotie.refused("doors P3 open", "no train at platform P3")
-    gaotie("occupy 3G", "doors P3 open", "run 1s")
-    assert gaotie.sim.field.doors_open["P3:left"]
-    gaotie("doors P3 close", "run 1s")
-    assert not gaotie.sim.field.doors_open["P3:left"]
+    gaotie("occupy 3G", "doors P3 open", "run 4s")
+    assert gaotie.sim.field.doors["P3:left"].is_open
+    gaotie("doors P3 close", "run 5s")
+    assert not gaotie.sim.field.doors["P3:left"].is_open
+
+
+def test_doors_do_not_open_when_platform_occupancy_is_disturbed_or_close_when_gmj_failed(gaotie: Driver) -> None:
+    gaotie("fault psd-no-open P3", "occupy 3G", "doors P3 open", "run 4s")
+    assert not gaotie.sim.field.doors["P3:left"].is_open
+    gaotie("repair psd-no-open P3", "fault psd-no-close P3", "doors P3 open", "run 4s", "doors P3 close", "run 5s")
+    assert gaotie.sim.field.doors["P3:left"].is_open
+    gaotie("route X3 XFCK", "run 10s", "expect signal X3 H")
 
 
 # ---- USU, automatic block, cab codes on gaotie --------------------------------------------------------------
@@ -104,8 +105,15 @@ def test_usu_over_no18_turnout_with_onward_route_open(gaotie: Driver) -> None:
 
 def test_flasher_failure_degrades_usu_to_uu(gaotie: Driver) -> None:
     gaotie("route X X3", "route X3 XFCK", "run 12s", "expect signal X USU")
-    gaotie.sim.field.set_flasher_failed("X", True)
-    gaotie("run 1s", "expect signal X UU", "expect alarm flasher")
+    gaotie("fault flasher X", "run 3s", "expect signal X UU", "expect alarm flasher")
+
+
+def test_classic_relay_flasher_bad_contact_is_silent(gaotie: Driver) -> None:
+    """Seed 004: with the classic RC flasher a bad SNJ contact leaves the flashing lamp dark while SNJ keeps
+    working, so the interlocking still commands USU and the signal silently shows a single yellow."""
+    gaotie("route S S4", "route S4 SFCK", "run 15s", "expect signal S USU", "fault flasher S", "run 5s",
+           "expect signal S USU", "expect no-alarm flasher")
+    assert gaotie.sim.field.lit_lamps("S") == {"U2"}
 
 
 def test_departure_aspect_counts_clear_block_sections(gaotie: Driver) -> None:

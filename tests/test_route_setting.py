@@ -87,17 +87,14 @@ def test_reopen_refused_while_the_condition_is_still_lost(jiaopei: Driver) -> No
 
 def test_turnout_losing_indication_closes_signal(jiaopei: Driver) -> None:
     jiaopei("route X XI", "run 1s", "expect signal X U")
-    jiaopei.sim.field.set_indication_lost("1", True)
-    jiaopei("run 1s", "expect signal X H", "expect alarm turnout 1 has no indication")
+    jiaopei("fault no-indication 1", "run 1s", "expect signal X H", "expect alarm turnout 1 has no indication")
 
 
 def test_squeezed_turnout_alarm_after_thirty_seconds_without_indication(jiaopei: Driver) -> None:
-    jiaopei.sim.field.set_indication_lost("5", True)
-    jiaopei("run 29s", "expect no-alarm squeezed", "run 2s", "expect alarm turnout 5 squeezed")
-    jiaopei.sim.field.set_indication_lost("5", False)
-    jiaopei("run 1s", "expect no-alarm squeezed")
+    jiaopei("fault squeezed 5", "run 29s", "expect no-alarm squeezed", "run 2s", "expect alarm turnout 5 squeezed",
+            "repair squeezed 5", "run 1s", "expect no-alarm squeezed")
 
 
 def test_move_timeout(jiaopei: Driver) -> None:
-    jiaopei.sim.field.jammed.add("5")
-    jiaopei("throw 5 reverse", "run 20s", "expect alarm turnout 5 did not reach reverse", "expect turnout 5 none")
+    jiaopei("fault high-resistance 5", "throw 5 reverse", "run 20s", "expect alarm turnout 5 did not reach reverse",
+            "expect turnout 5 none")

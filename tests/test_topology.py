@@ -257,9 +257,11 @@ def test_gaotie_dead_zones_at_the_diamond(gaotie: Station) -> None:
     assert zones == {"J-13": 11.2, "J-57": 8.446}
     for joint in zones:
         assert set(gaotie.joint_sections(joint)) == {"1-7DG", "3-5DG"}
-    # the only design warnings are these two deliberate ones
-    assert len(gaotie.warnings) == 2
+    # the only design warnings are about these two deliberate ones: stagger over the limit, and long enough to
+    # hold a whole bogie
+    assert len(gaotie.warnings) == 4
     assert {w.message.split("'")[1] for w in gaotie.warnings} == {"J-13", "J-57"}
+    assert sum("can hold a whole bogie" in w.message for w in gaotie.warnings) == 2
 
 
 def test_gaotie_carriers_alternate_across_every_joint(gaotie: Station) -> None:

@@ -1,0 +1,66 @@
+"""Platform screen doors (站台门) and their interface relays (DOMAIN.md section 5; seed 004 lines 3249-3428).
+
+Interlocking -> doors: ZCKJ (platform track occupied / authorised), KMJ (open), GMJ (close).
+Doors -> interlocking: PDKJ (all doors closed and locked), PDQCJ (interlock bypass, 互锁解除).
+The doors open only with KMJ AND ZCKJ; with KMJ but no ZCKJ they stay closed. GMJ closes them.
+Faults: ``stuck`` (a door stuck open: PDKJ never returns), ``no_close`` (GMJ failed: no closing),
+``no_open`` (occupancy detection disturbed: ZCKJ never reaches the doors, so they do not open),
+``bypass`` (the bypass switch: PDQCJ up whatever the doors do).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from .equipment import equipment
+
+
+@dataclass
+class DoorFaults:
+    stuck: bool = False
+    no_close: bool = False
+    no_open: bool = False
+    bypass: bool = False
+
+
+@dataclass
+class PlatformDoors:
+    key: str  # "P3:left"
+    opening: float = 0.0  # 0 closed and locked, 1 fully open
+    moving: int = 0  # +1 opening, -1 closing, 0 still
+    faults: DoorFaults = field(default_factory=DoorFaults)
+
+    @property
+    def pdkj(self) -> bool:
+        return self.opening <= 0.0 and self.moving == 0 and not self.faults.stuck
+
+    @property
+    def pdqcj(self) -> bool:
+        return self.faults.bypass
+
+    @property
+    def is_open(self) -> bool:
+        return self.opening > 0.0 or self.faults.stuck
+
+    def command(self, zckj: bool, kmj: bool, gmj: bool) -> None:
+        authorised = zckj and not self.faults.no_open
+        if kmj and authorised and not gmj:
+            self.moving = 1
+        elif gmj and not self.faults.no_close and self.opening > 0.0:
+            self.moving = -1
+
+    def step(self, dt: float) -> bool:
+        """Advance the doors; True when PDKJ may have changed."""
+        if self.moving == 0:
+            return False
+        spec = equipment().doors
+        before = self.pdkj
+        if self.moving > 0:
+            self.opening = min(1.0, self.opening + dt / spec.open_s)
+            if self.opening >= 1.0:
+                self.moving = 0
+        else:
+            self.opening = max(0.0, self.opening - dt / spec.close_s)
+            if self.opening <= 0.0:
+                self.moving = 0
+        return before != self.pdkj

@@ -1,0 +1,115 @@
+"""Switch machines (转辙机) ZD6, ZDJ9, S700K with their indication relays DBJ / FBJ.
+
+A drive command starts the motor; the switch rails arrive after the machine's throw time if the switching resistance
+is within the rated force, and lock; only a locked turnout in an end position gives an indication (DBJ normal,
+FBJ reverse). Faults (seed 004: switching resistance; 4 mm obstruction test; insulation burning):
+
+- ``obstruction``: something of ``mm`` (>= 4 mm) between switch rail and stock rail: the rails cannot close and lock,
+  so no indication at either end;
+- ``high_resistance``: switching resistance above the rated force: the clutch slips, the motor runs, the turnout
+  never arrives (and keeps its old position's rails unlocked, so no indication);
+- ``no_indication``: the indication circuit is broken: the turnout may be in position, DBJ and FBJ stay down;
+- ``squeezed``: trailed through in the wrong position (挤岔): the lock is broken, no indication until repaired;
+- ``insulation``: broken insulation at the machine shorts the track circuit: a red band on its section (the field
+  applies it to the section's track circuit).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from .equipment import MachineSpec, equipment
+
+
+@dataclass
+class MachineFaults:
+    obstruction_mm: float = 0.0
+    resistance_N: float | None = None  # switching resistance override
+    no_indication: bool = False
+    squeezed: bool = False
+    insulation: bool = False
+
+    def any(self) -> bool:
+        return bool(self.obstruction_mm or self.resistance_N is not None or self.no_indication or self.squeezed
+                    or self.insulation)
+
+
+class SwitchMachine:
+    def __init__(self, turnout: str, machine: str, position: str = "normal") -> None:
+        self.turnout = turnout
+        self.type = machine
+        self.spec: MachineSpec = equipment().machines[machine]
+        self.rails: str | None = position  # where the switch rails lie (None: between positions)
+        self.locked = True
+        self.target: str | None = None
+        self.progress = 0.0  # seconds of successful movement towards target
+        self.running = False  # motor current flowing
+        self.faults = MachineFaults()
+
+    # ---- what the interlocking reads --------------------------------------------------------------------------
+    @property
+    def dbj(self) -> bool:
+        return self._indicates("normal")
+
+    @property
+    def fbj(self) -> bool:
+        return self._indicates("reverse")
+
+    def _indicates(self, position: str) -> bool:
+        f = self.faults
+        if f.no_indication or f.squeezed or not self.locked or self.rails != position:
+            return False
+        return f.obstruction_mm < equipment().obstruction_lock_mm
+
+    @property
+    def resistance_N(self) -> float:
+        r = self.faults.resistance_N
+        return self.spec.nominal_resistance_N if r is None else r
+
+    @property
+    def clutch_slips(self) -> bool:
+        return self.resistance_N > self.spec.rated_force_N
+
+    # ---- commands and time ------------------------------------------------------------------------------------
+    def drive(self, target: str | None) -> None:
+        """The interlocking's drive command (None: no drive)."""
+        if target is None:
+            self.running = False
+            self.target = None
+            return
+        if target == self.target and self.running:
+            return
+        if target == self.rails and self.locked and self.target is None:
+            return
+        self.target = target
+        self.running = True
+        self.locked = False
+        self.progress = 0.0
+        self.rails = None if self.rails != target else self.rails
+
+    def step(self, dt: float) -> bool:
+        """Advance the motor; True when the indication may have changed."""
+        if not self.running or self.target is None:
+            return False
+        if self.clutch_slips:
+            return False  # the motor runs, the clutch slips, the rails do not move
+        self.progress += dt
+        if self.progress + 1e-9 < self.spec.throw_s:
+            return False
+        self.rails = self.target
+        self.running = False
+        self.target = None
+        # the lock closes only if nothing holds the switch rail off the stock rail
+        self.locked = self.faults.obstruction_mm < equipment().obstruction_lock_mm
+        return True
+
+    def trail(self, position: str) -> None:
+        """A train trails through in ``position`` while the turnout lies otherwise: it is squeezed (挤岔)."""
+        if self.rails != position:
+            self.rails = position
+            self.locked = False
+            self.faults.squeezed = True
+
+    def repair_squeeze(self) -> None:
+        self.faults.squeezed = False
+        self.locked = self.rails is not None and self.faults.obstruction_mm < equipment().obstruction_lock_mm
