@@ -225,7 +225,7 @@ class Field:
                 sf.ballast_ohm_km = float(f.get("ohm_km")) if on else None
             else:
                 n = int(float(f.get("n")))
-                count = len(getattr(self.circuits[t].model, "capacitor_positions_m", ()))
+                count = len(getattr(self.circuits[t].model, "capacitors_m", ()))
                 if on and not 1 <= n <= count:
                     return f"section {t} has {count} compensation capacitors; n must be 1..{count}"
                 if on:

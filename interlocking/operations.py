@@ -62,7 +62,7 @@ class Interlocking(Engine):
         if r.signal in self.by_signal:
             return f"signal {r.signal} already has route {self.by_signal[r.signal]} set"
         for other, why in r.conflicts.items():
-            if other in self.routes:
+            if other in self.routes and self._still_holds(self.routes[other], r):
                 return f"conflicting route {other} is locked ({why})"
         for s in r.all_sections:
             owner = self.section_lock.get(s)
@@ -88,6 +88,18 @@ class Interlocking(Engine):
                 if not self.clear(ms.section):
                     return f"turnout {member} cannot move: section {ms.section} is occupied"
         return ""
+
+    def _still_holds(self, rs: RouteState, r: Route) -> bool:
+        """Does the active route ``rs`` still lock something ``r`` needs? Sections released behind a train are free
+        for the next route, as in a real CBI, even while the rest of the train's route is still locked."""
+        wanted = set(r.all_sections)
+        held = {s for i, s in enumerate(rs.route.sections) if not rs.released[i]}
+        held |= {f.section for f in rs.route.fouling} | set(rs.route.overlap_sections)
+        if wanted & held:
+            return True
+        need = {t.id: t.position for t in r.all_turnouts}
+        return any(t.id in need and need[t.id] is not t.position and rs.id in self.turnouts[t.id].locks
+                   for t in rs.route.all_turnouts)
 
     def route_of(self, signal: str) -> RouteState | None:
         rid = self.by_signal.get(signal)

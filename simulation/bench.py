@@ -8,6 +8,8 @@ For each station:
 * ``load_s``: YAML -> validated :class:`~stations.station.Station`; ``table_build_s``: :func:`build_table` on it;
 * ``cycle_us_idle``: mean wall time of one :meth:`Simulation.step` (field step + interlocking cycle) with nothing
   happening;
+* ``circuit_us_busy``: of the busy cycle, the time in the trackside field: its step (machines, lamps, flashers,
+  doors) and the track-circuit re-evaluations the moving occupancy causes.
 * ``cycle_us_busy``: the same with up to 20 non-conflicting train routes set, opened and traversed over and over: a
   driver occupies each route's approach and sections in order and vacates them behind (``field.occupy/vacate``, the
   teaching base's switch K), and sets the route again once it has released;
@@ -27,6 +29,7 @@ import platform
 import resource
 import sys
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -206,6 +209,26 @@ class _Traversal:
 
 
 # ---- measuring -----------------------------------------------------------------------------------------------------
+def _time_circuits(sim: Simulation) -> list[float]:
+    """Time spent in the trackside field (its step, and the track-circuit evaluations occupancy changes cause),
+    accumulated in the returned one-element list while the busy run goes on."""
+    spent = [0.0]
+    fld = sim.field
+    perf = time.perf_counter
+
+    def timed(fn: Callable[..., None]) -> Callable[..., None]:
+        def wrapper(*args: Any) -> None:
+            t0 = perf()
+            fn(*args)
+            spent[0] += perf() - t0
+        return wrapper
+
+    fld.step = timed(fld.step)  # type: ignore[method-assign]
+    fld.occupy = timed(fld.occupy)  # type: ignore[method-assign]
+    fld.vacate = timed(fld.vacate)  # type: ignore[method-assign]
+    return spent
+
+
 def _time_steps(sim: Simulation, cycles: int) -> float:
     step = sim.step
     t0 = time.perf_counter()
@@ -262,6 +285,7 @@ def measure(station_source: str, *, label: str, text: bool, idle_cycles: int, bu
     stepping = 0.0
     step = sim.step
     perf = time.perf_counter
+    circuit = _time_circuits(sim)
     start = perf()
     for _ in range(busy_cycles):
         for d in drivers:
@@ -276,6 +300,7 @@ def measure(station_source: str, *, label: str, text: bool, idle_cycles: int, bu
     out["busy_warmup_cycles"] = warmup
     out["busy_cycles"] = busy_cycles
     out["cycle_us_busy"] = round(stepping / busy_cycles * 1e6, 2)
+    out["circuit_us_busy"] = round(circuit[0] / busy_cycles * 1e6, 2)
     out["realtime_factor"] = round(busy_cycles * sim.cycle_s / wall, 1)
     out["busy_route_settings"] = sum(d.settings for d in drivers)
     out["busy_traversals"] = sum(d.traversals for d in drivers)
@@ -381,6 +406,7 @@ _TEXT_ROWS = [
     ("turnouts", "turnouts", "{:d}"), ("sections", "sections", "{:d}"), ("routes", "routes", "{:d}"),
     ("load_s", "load (s)", "{:.3f}"), ("table_build_s", "table build (s)", "{:.3f}"),
     ("cycle_us_idle", "cycle idle (us)", "{:.1f}"), ("cycle_us_busy", "cycle busy (us)", "{:.1f}"),
+    ("circuit_us_busy", "  of it circuits (us)", "{:.1f}"),
     ("busy_routes", "busy routes", "{:d}"), ("realtime_factor", "real-time factor (busy)", "{:.0f}x"),
     ("realtime_factor_idle", "real-time factor (idle)", "{:.0f}x"), ("busy_traversals", "traversals", "{:d}"),
     ("busy_stalls", "stalls", "{:d}"), ("peak_memory_mb", "peak RSS (MB)", "{:.1f}"),

@@ -40,7 +40,7 @@ USAGE = {
     "fault": "fault KIND TARGET [key=value ...]",
     "repair": "repair KIND TARGET",
     "faults": "faults",
-    "axles": "axles NAME TRACK POSITION [POSITION ...] | axles NAME clear",
+    "axles": "axles NAME TRACK POSITION [POSITION ...] [TRACK POSITION ...] | axles NAME clear",
     "occupy": "occupy SECTION",
     "vacate": "vacate SECTION",
     "run": "run DURATION",
@@ -135,24 +135,30 @@ def _axles(sim: Simulation, args: list[str]) -> Result:
         return Result.accept(f"wheelsets {args[0]} removed")
     if len(args) < 3:
         return Result.refuse(f"usage: {USAGE['axles']}")
-    name, track, *positions = args
-    if track not in sim.station.tracks:
-        return Result.refuse(f"there is no track '{track}' at {sim.station.id}")
-    lo, hi = sim.station.track_span(track)
-    axles = []
-    for p in positions:
+    name, *words = args
+    axles: list[Axle] = []
+    track = ""
+    for w in words:
+        if w in sim.station.tracks:
+            track = w
+            continue
         try:
-            x = float(p)
+            x = float(w)
         except ValueError:
-            return Result.refuse(f"'{p}' is not a position in metres")
+            return Result.refuse(f"'{w}' is neither a track of {sim.station.id} nor a position in metres")
+        if not track:
+            return Result.refuse(f"name the track before the positions: {USAGE['axles']}")
+        lo, hi = sim.station.track_span(track)
         if not lo <= x <= hi:
             return Result.refuse(f"position {x:g} m is off track {track} ({lo:g}-{hi:g} m)")
         axles.append(Axle(track, x))
+    if not axles:
+        return Result.refuse(f"usage: {USAGE['axles']}")
     sim.place_axles(name, axles)
     shunting = sorted({s.section for a in axles if (s := sim.field.geometry.shunt(a)) is not None})
     hidden = sum(sim.field.geometry.shunt(a) is None for a in axles)
     note = f"; {hidden} in dead zones" if hidden else ""
-    return Result.accept(f"{len(axles)} wheelsets {name} on {track}, shunting {', '.join(shunting) or 'nothing'}{note}")
+    return Result.accept(f"{len(axles)} wheelsets {name}, shunting {', '.join(shunting) or 'nothing'}{note}")
 
 
 def _run(sim: Simulation, args: list[str]) -> Result:

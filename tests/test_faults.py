@@ -130,3 +130,22 @@ def test_fault_commands_refuse_with_reasons(jiaopei: Driver) -> None:
 
 def test_faults_lists_active_faults(jiaopei: Driver) -> None:
     jiaopei("fault broken-rail IG", "fault no-indication 3", "faults", "expect accepted no-indication 3")
+
+
+def test_dead_capacitor_on_a_long_zpw_section_lowers_the_receive_voltage(gaotie: Driver) -> None:
+    circuit = gaotie.sim.field.circuits["X2JG"]  # 1400 m, 14 capacitors
+    healthy = circuit.voltage
+    gaotie("fault capacitor X2JG n=7 mode=open", "run 1s")
+    assert circuit.voltage < 0.95 * healthy  # the adjustment voltage falls
+    gaotie("expect section X2JG free")  # still above the drop level: no red band
+    gaotie("repair capacitor X2JG", "fault capacitor X2JG n=7 mode=short", "run 1s", "expect section X2JG occupied",
+           "expect signal 1217 H")  # the block signal in rear of it closes
+    gaotie.refused("fault capacitor IG n=99", "n must be 1..7")
+
+
+def test_route_over_sections_released_behind_a_train_can_be_set_before_the_train_route_ends(
+        jiaopei: Driver) -> None:
+    jiaopei("route X XI", "run 1s", "occupy IAG", "occupy 7DG", "run 1s", "vacate IAG", "occupy 1DG", "run 1s",
+            "vacate 7DG", "run 1s", "expect section 7DG free", "expect route X XI locked")
+    jiaopei("shunt D1 D3", "run 5s", "expect signal D1 B")  # 7DG only: released behind the train
+    jiaopei.refused("shunt D3 D1", "conflicting route D1-D3")  # the shunting route now holds 7DG
