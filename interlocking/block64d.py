@@ -7,6 +7,7 @@ once the train occupies the departure section the line is blocked until the neig
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from enum import StrEnum
 
@@ -89,3 +90,34 @@ class BlockLink:
     def arrival_complete(self) -> None:
         if self.state is BlockState.arriving:
             self.state = BlockState.arrived
+
+
+Notify = Callable[[str, str], None]  # (kind, text) -> an event in the interlocking's log
+
+
+def line_pulses_in(links: dict[str, BlockLink], link: str, msgs: set[str], event: Notify) -> None:
+    """Pulses from the neighbour's block machine."""
+    bl = links.get(link)
+    if bl is None:
+        return
+    for m in sorted(msgs):
+        before = bl.state
+        bl.receive(m)
+        if bl.state is not before:
+            event("block", f"block line {link}: {m} received, {before.value} -> {bl.state.value}")
+
+
+def line_tracks_changed(links: dict[str, BlockLink], tracks: set[str], clear: Callable[[str], bool],
+                        send: Callable[[str, str], None], event: Notify) -> None:
+    """A departure section became occupied (our train left: DEPART) or clear (the neighbour's train arrived)."""
+    for bl in links.values():
+        if bl.departure_section not in tracks:
+            continue
+        if not clear(bl.departure_section):
+            pulse = bl.departure_section_occupied()
+            if pulse:
+                send(bl.id, pulse)
+                event("block", f"block line {bl.id}: train departed, line blocked")
+        elif bl.state is BlockState.arriving:
+            bl.arrival_complete()
+            event("block", f"block line {bl.id}: train arrived complete; restore the block")

@@ -18,7 +18,8 @@ from stations.schema import SignalKind
 from stations.station import Station
 
 from .aspects import downgrade, is_open, select_aspect, stop_aspect
-from .block64d import BlockLink
+from .autoblock import AutoBlock, cab_codes
+from .block64d import BlockLink, line_pulses_in, line_tracks_changed
 from .io import Alarm, DoorCommand, Event, Outputs, RelayBoard
 from .rules import RuleSet, load_rules
 from .state import RouteStage, RouteState, SignalState, TurnoutState
@@ -67,7 +68,7 @@ class Engine:
             self.signal_by_entry.setdefault(sec, []).append(sig_id)
         self.platform_doors = {p.section: [f"{p.id}:{d.side.value}" for d in p.screen_doors]
                                for p in st.model.platforms if p.screen_doors}
-        self._block_signals = self._chain_block_signals()
+        self.autoblock = AutoBlock(st)
         self.codes_dirty = True
         for key in (k for keys in self.platform_doors.values() for k in keys):
             self.out.doors.setdefault(key, DoorCommand())
@@ -97,9 +98,9 @@ class Engine:
         if tracks:
             self._check_spad(tracks)
         for link, msgs in pulses.items():
-            self._line_in(link, msgs)
+            line_pulses_in(self.links, link, msgs, self.event)
         if tracks and self.links:
-            self._line_tracks(tracks)
+            line_tracks_changed(self.links, tracks, self.clear, self.send, self.event)
         for t_id in turnouts:
             if self.board.indication(t_id) is None:
                 if t_id not in self.no_indication:
@@ -119,10 +120,11 @@ class Engine:
             self._advance(rs)
         self._guide_only()
         self._overlaps()
-        if self._block_signals and (tracks or self.out.changed_signals):
-            self._update_block_signals()
+        if self.autoblock.signals and (tracks or self.out.changed_signals):
+            self.autoblock.update(self.out, self.clear, self._proven)
         if self.codes_dirty or self.out.changed_signals:
-            self._update_cab_codes()
+            self.codes_dirty = False
+            self.out.cab_codes = cab_codes(self.station, self.rules, self.routes.values(), self.out.signals)
         del doors
         return self.out
 
@@ -537,88 +539,5 @@ class Engine:
                         rs.stage = RouteStage.in_use
                         rs.release_at = None
 
-    # ---- 64D ------------------------------------------------------------------------------------------------
-    def _line_in(self, link: str, msgs: set[str]) -> None:
-        bl = self.links.get(link)
-        if bl is None:
-            return
-        for m in sorted(msgs):
-            before = bl.state
-            bl.receive(m)
-            if bl.state is not before:
-                self.event("block", f"block line {link}: {m} received, {before.value} -> {bl.state.value}")
-
     def send(self, link: str, pulse: str) -> None:
         self.out.line_out.setdefault(link, set()).add(pulse)
-
-    def _line_tracks(self, tracks: set[str]) -> None:
-        for bl in self.links.values():
-            if bl.departure_section not in tracks:
-                continue
-            if not self.clear(bl.departure_section):
-                pulse = bl.departure_section_occupied()
-                if pulse:
-                    self.send(bl.id, pulse)
-                    self.event("block", f"block line {bl.id}: train departed, line blocked")
-            elif bl.state.value == "arriving":
-                bl.arrival_complete()
-                self.event("block", f"block line {bl.id}: train arrived complete; restore the block")
-
-    # ---- automatic block and cab codes ----------------------------------------------------------------------
-    def _chain_block_signals(self) -> list[tuple[str, tuple[str, ...], str | None]]:
-        st = self.station
-        topo = st.topology
-        out: list[tuple[str, tuple[str, ...], str | None]] = []
-        for sig in st.model.signals:
-            if sig.kind is not SignalKind.block:
-                continue
-            sections: list[str] = []
-            move = topo.start_move(sig.at, sig.direction)
-            nxt_signal = None
-            for _ in range(100):
-                sec = st.tracks[move[0]].section
-                if not sections or sections[-1] != sec:
-                    sections.append(sec)
-                far = topo.far_node(move)
-                ahead = [s for s in st.signals_at(far) if s.direction is sig.direction]
-                if ahead:
-                    nxt_signal = ahead[0].id
-                    break
-                moves = topo.next_moves(move)
-                if not moves:
-                    break
-                move = moves[0][0]
-            out.append((sig.id, tuple(sections), nxt_signal))
-        return out
-
-    def _update_block_signals(self) -> None:
-        """Four-aspect automatic block: each signal follows its own sections and the signal ahead. The chain is
-        evaluated until it settles, so a change at one end reaches the other within the cycle."""
-        for _ in range(len(self._block_signals) + 1):
-            changed = False
-            for sig, sections, nxt in self._block_signals:
-                if any(not self.clear(s) for s in sections):
-                    aspect = "H"
-                else:
-                    ahead = self.out.signals.get(nxt, "L") if nxt else "L"
-                    aspect = {"H": "U", "A": "U", "": "U", "U": "LU", "UU": "U"}.get(ahead, "L")
-                shown = self._proven(sig, aspect) if aspect != "H" else "H"
-                if self.out.signals.get(sig) != shown:
-                    self.out.set_aspect(sig, shown)
-                    changed = True
-            if not changed:
-                return
-
-    def _update_cab_codes(self) -> None:
-        self.codes_dirty = False
-        codes: dict[str, str | None] = {s.id: None for s in self.station.model.sections if s.coded}
-        for rs in self.routes.values():
-            r = rs.route
-            if r.kind != "train" or rs.stage not in (RouteStage.open, RouteStage.in_use):
-                continue
-            governing = r.end_signal if r.end_signal else r.signal
-            code = self.rules.cab_codes.get(self.out.signals.get(governing, "H"))
-            for i, s in enumerate(r.sections):
-                if s in codes and not rs.released[i]:
-                    codes[s] = code
-        self.out.cab_codes = codes
