@@ -6,6 +6,7 @@ Nothing here reads the wall clock; pacing to real time belongs to the console.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 
 from circuits.field import Field
@@ -20,6 +21,19 @@ from stations.station import Station
 
 from .neighbour import Neighbours
 from .wiring import Wiring
+
+
+@dataclass(frozen=True)
+class TrainView:
+    """What a front end shows of a train: its name, the sections its wheelsets shunt, speed and direction."""
+
+    name: str
+    sections: tuple[str, ...]
+    speed_kmh: float
+    direction: str  # "down" or "up"
+    mode: str  # "manual", "signal", "auto"
+    head_track: str
+    head_m: float  # position of the leading wheelset along the line
 
 
 class Simulation:
@@ -100,6 +114,10 @@ class Simulation:
         ts = self.interlocking.turnouts[turnout]
         locked = bool(ts.locks) or ts.single_locked or ts.guide_locked
         return self.interlocking.board.indication(turnout), locked
+
+    def train_views(self) -> list[TrainView]:
+        """Every train in the yard (empty until trains are placed with ``train NAME at SECTION``)."""
+        return []
 
     def alarm_texts(self) -> list[str]:
         return [a.text for a in self.interlocking.alarms.values()]
