@@ -52,7 +52,7 @@ def pytest_collect_file(file_path: Path, parent: pytest.Collector) -> ScriptFile
     wanted = any(fnmatch(file_path.name, p) for p in patterns) or parent.session.isinitpath(file_path)
     if not wanted or not is_script(file_path):
         return None
-    return ScriptFile.from_parent(parent, path=file_path)  # type: ignore[no-any-return]
+    return ScriptFile.from_parent(parent, path=file_path)
 
 
 class ScriptError(Exception):
