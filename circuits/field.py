@@ -180,6 +180,10 @@ class Field:
         d = self.doors[key]
         return d.pdkj, d.pdqcj
 
+    def note_turnout(self, turnout: str) -> None:
+        """A turnout's indication may have changed outside a step (a train trailed through it)."""
+        self._changes.turnouts.add(turnout)
+
     def take_changes(self) -> Changes:
         out = self._changes
         self._changes = Changes()

@@ -376,8 +376,10 @@ class Engine:
             self.close_signal(rs, blocker, abnormal=True)
             return
         aspect = self._proven(r.signal, self._wanted_aspect(rs))
-        if aspect != self.out.signals.get(r.signal):
+        before = self.out.signals.get(r.signal)
+        if aspect != before:
             self.out.set_aspect(r.signal, aspect)
+            self.event("signal", f"signal {r.signal}: {before} -> {aspect}")
 
     def _keep_guide(self, rs: RouteState) -> None:
         r = rs.route

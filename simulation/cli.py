@@ -100,6 +100,30 @@ def cmd_test(args: argparse.Namespace) -> int:
     return 0 if failed == 0 and outcomes else 1
 
 
+def cmd_run(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from .scenario import parse_scenario, run_scenario
+    from .timeparse import parse_duration
+
+    try:
+        sc = parse_scenario(Path(args.scenario))
+    except StationError as exc:
+        return _print_errors(exc)
+    until = None
+    if args.until:
+        try:
+            until = parse_duration(args.until)
+        except ValueError as exc:
+            print(f"--until: {exc}", file=sys.stderr)
+            return 2
+    try:
+        status, _ = run_scenario(sc, until)
+    except StationError as exc:
+        return _print_errors(exc)
+    return status
+
+
 def cmd_run_default(args: argparse.Namespace) -> int:
     """Headless stand-in for the console until it exists: load the default station and print its state."""
     try:
@@ -142,6 +166,9 @@ def build_parser() -> argparse.ArgumentParser:
     sp = add("bench", cmd_bench, "benchmark table building and the interlocking cycle (hub and jiaopei)")
     sp.add_argument("--quick", action="store_true", help="fewer cycles (under a minute)")
     sp.add_argument("--format", choices=("json", "text"), default="json")
+    sp = add("run", cmd_run, "run a scenario headless and print the event log")
+    sp.add_argument("scenario", help="scenario YAML file")
+    sp.add_argument("--until", metavar="DURATION", help="keep running to this simulated time (e.g. 10min)")
     from .zpwcli import register as register_zpw
 
     register_zpw(add)

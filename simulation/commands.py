@@ -105,7 +105,7 @@ def _fault(sim: Simulation, args: list[str]) -> Result:
     why = sim.field.inject(parsed)
     if why:
         return Result.refuse(f"fault {parsed.kind}: {why}")
-    sim.interlocking.event("fault", f"fault injected: {parsed.describe()}")
+    sim.log("fault", f"fault injected: {parsed.describe()}")
     return Result.accept(f"fault injected: {parsed.describe()}")
 
 
@@ -115,7 +115,7 @@ def _repair(sim: Simulation, args: list[str]) -> Result:
     why = sim.field.repair(args[0], args[1])
     if why:
         return Result.refuse(why)
-    sim.interlocking.event("fault", f"repaired: {args[0]} {args[1]}")
+    sim.log("fault", f"repaired: {args[0]} {args[1]}")
     return Result.accept(f"repaired: {args[0]} {args[1]}")
 
 
@@ -291,6 +291,17 @@ COMMANDS: dict[str, Handler] = {
     "run": _run,
     "expect": _expect,
 }
+
+
+def _with_trains() -> None:
+    from .trains.commands import TRAIN_COMMANDS
+    from .trains.commands import USAGE as TRAIN_USAGE
+
+    COMMANDS.update(TRAIN_COMMANDS)
+    USAGE.update(TRAIN_USAGE)
+
+
+_with_trains()
 
 
 def execute(sim: Simulation, line: str) -> Result:

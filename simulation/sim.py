@@ -6,12 +6,13 @@ Nothing here reads the wall clock; pacing to real time belongs to the console.
 
 from __future__ import annotations
 
+from collections import deque
 from dataclasses import dataclass
 from pathlib import Path
 
 from circuits.field import Field
 from circuits.railgeometry import Axle
-from interlocking.io import Result
+from interlocking.io import Event, Result
 from interlocking.operations import Interlocking
 from interlocking.rules import RuleSet, load_rules
 from interlocking.state import RouteStage
@@ -20,6 +21,7 @@ from stations.loader import load
 from stations.station import Station
 
 from .neighbour import Neighbours
+from .trains.fleet import Fleet, Train
 from .wiring import Wiring
 
 
@@ -50,12 +52,20 @@ class Simulation:
         self.t = 0.0
         self.last_result: Result | None = None
         self.parked: dict[str, list[Axle]] = {}  # named sets of wheelsets placed by hand (``axles`` command)
+        self.events: deque[Event] = deque(maxlen=20_000)  # the world's own events: trains, faults
+        self.alarms: dict[str, str] = {}  # the world's alarms (derailment, squeeze by a train)
+        self.fleet = Fleet(self.station, self.field, lambda: self.interlocking.out.signals, self.log,
+                           self._auto_limit)
         self.wiring.publish(self.interlocking.board, everything=True)
         self.interlocking.cycle(self.t)
 
     # ---- time -------------------------------------------------------------------------------------------------
     def step(self) -> None:
         il = self.interlocking
+        if self.fleet.trains:
+            self.fleet.step(self.cycle_s)
+            self._platforms()
+            self.update_axles()
         self.field.step(self.cycle_s, self.wiring.commands_from(il.out))
         self.t = round(self.t + self.cycle_s, 9)
         self.neighbours.step(self.t, il.out.line_out, self.field.track_up)
@@ -73,7 +83,31 @@ class Simulation:
             self.parked[name] = axles
         else:
             self.parked.pop(name, None)
-        self.field.set_axles([a for group in self.parked.values() for a in group])
+        self.update_axles()
+
+    def update_axles(self) -> None:
+        """Tell the field where every wheelset stands: trains and parked wheelsets."""
+        self.field.set_axles([a for group in self.parked.values() for a in group] + self.fleet.axles())
+
+    def log(self, kind: str, text: str) -> None:
+        self.events.append(Event(self.t, kind, text))
+        if kind == "alarm":
+            self.alarms[f"{len(self.alarms)}"] = text
+
+    def _auto_limit(self, train: Train) -> tuple[float, str] | None:
+        from .trains.automatic import auto_limit
+
+        return auto_limit(self, train)
+
+    def attach_auto(self, train: Train, plan: list[str]) -> Result:
+        from .trains.automatic import attach
+
+        return attach(self, train, plan)
+
+    def _platforms(self) -> None:
+        from .trains.ato import platform_doors
+
+        platform_doors(self)
 
     def run(self, seconds: float) -> None:
         for _ in range(max(0, round(seconds / self.cycle_s))):
@@ -116,11 +150,17 @@ class Simulation:
         return self.interlocking.board.indication(turnout), locked
 
     def train_views(self) -> list[TrainView]:
-        """Every train in the yard (empty until trains are placed with ``train NAME at SECTION``)."""
-        return []
+        """Every train in the yard."""
+        out = []
+        for tr in self.fleet.trains.values():
+            track, x = self.fleet.front(tr)
+            out.append(TrainView(tr.name, self.fleet.sections_of(tr), round(tr.speed_kmh, 2), tr.direction.value,
+                                 tr.mode, track, round(x, 2)))
+        return out
 
     def alarm_texts(self) -> list[str]:
-        return [a.text for a in self.interlocking.alarms.values()]
+        return [a.text for a in self.interlocking.alarms.values()] + list(self.alarms.values())
 
     def event_texts(self) -> list[str]:
-        return [f"{e.t:9.2f} {e.kind:8} {e.text}" for e in self.interlocking.events]
+        merged = sorted([*self.interlocking.events, *self.events], key=lambda e: e.t)
+        return [f"{e.t:9.2f} {e.kind:8} {e.text}" for e in merged]

@@ -1,0 +1,242 @@
+"""The built-in kinematic train engine: trains as consists of wheelsets moving over the topology.
+
+Each step every train picks a target speed from its driver, accelerates or brakes towards it, moves, and the field
+is told where every wheelset stands, so the track circuits (and through them the interlocking) see the trains.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+from circuits.field import Field
+from circuits.railgeometry import Axle
+from stations.schema import Direction
+from stations.station import Station
+
+from .consist import Consist
+from .drivers import driving_rules, look_ahead, stopping_speed, target_speed
+from .movement import OUTSIDE, Notify, Position, Track
+
+MODES = ("manual", "signal", "auto")
+
+
+@dataclass
+class PlatformStop:
+    """ATO platform stop (seed 003): stop in the window, open the doors on the platform side with the screen doors,
+    dwell, close, and leave only with the doors closed and locked."""
+
+    platform: str
+    section: str
+    door_keys: tuple[str, ...]
+    window_m: float
+    state: str = "approaching"  # approaching, stopped, doors_open, closing, done, missed
+    stop_x: float = 0.0
+    until: float = 0.0
+
+
+@dataclass
+class Train:
+    name: str
+    consist: Consist
+    pos: Position
+    mode: str = "manual"
+    speed_ms: float = 0.0
+    commanded_kmh: float = 0.0  # manual driving
+    aspect_limit_ms: float = 1e9  # speed of the last aspect passed
+    state: str = "running"  # running, stopped at buffer, derailed, left
+    why: str = ""  # what limits its speed now
+    platform_stop: PlatformStop | None = None
+    train_doors_open: bool = False
+    controller: object | None = None  # the automatic shunting controller, when in auto mode
+    shunting: bool = False  # a shunting movement (heeds shunting signals) rather than a train movement
+    extra: dict[str, object] = field(default_factory=dict)
+
+    @property
+    def direction(self) -> Direction:
+        return self.pos.moves[-1][1]
+
+    @property
+    def speed_kmh(self) -> float:
+        return self.speed_ms * 3.6
+
+
+Aspects = Callable[[], dict[str, str]]
+
+
+class Fleet:
+    """Every train of one simulation."""
+
+    def __init__(self, station: Station, fld: Field, aspects: Aspects, notify: Notify,
+                 auto_limit: Callable[[Train], tuple[float, str] | None] | None = None) -> None:
+        self.auto_limit = auto_limit
+        self.station = station
+        self.field = fld
+        self.track = Track(station, fld)
+        self.aspects = aspects
+        self.notify = notify
+        self.trains: dict[str, Train] = {}
+        self.t = 0.0
+        self.dt = 0.25
+
+    # ---- placing -------------------------------------------------------------------------------------------------
+    def place(self, name: str, consist: Consist, section: str, direction: Direction, mode: str,
+              back_m: float = 5.0) -> str:
+        pos = self.track.place(section, direction, consist.length_m, back_m)
+        if isinstance(pos, str):
+            return pos
+        train = Train(name, consist, pos, mode)
+        self.trains[name] = train
+        return ""
+
+    def remove(self, name: str) -> None:
+        self.trains.pop(name, None)
+
+    # ---- stepping ----------------------------------------------------------------------------------------------
+    def step(self, dt: float) -> None:
+        self.t += dt
+        self.dt = dt
+        for train in list(self.trains.values()):
+            self._step_train(train, dt)
+
+    def _step_train(self, tr: Train, dt: float) -> None:
+        if tr.state in ("derailed", "left"):
+            return
+        c = tr.consist
+        target, why = self._target(tr)
+        if tr.platform_stop is not None and tr.mode != "manual":
+            target, why = self._platform(tr, target, why)
+        tr.why = why
+        if tr.speed_ms < target:
+            tr.speed_ms = min(target, tr.speed_ms + c.accel_ms2 * dt)
+        else:
+            tr.speed_ms = max(target, tr.speed_ms - c.brake_ms2 * dt)
+        ds = tr.speed_ms * dt
+        if ds <= 0.0:
+            return
+        stop_at = self._exact_stop(tr)
+        if stop_at is not None and ds >= stop_at:
+            ds = max(stop_at, 0.0)  # reach the stopping point exactly rather than overshoot by a step
+            tr.speed_ms = 0.0
+        self._note_signals_passed(tr, ds)
+        moved, stop = self.track.advance(tr.name, tr.pos, ds, self.notify)
+        if stop:
+            tr.speed_ms = 0.0
+            tr.state = "derailed" if stop == "derailed" else "running"
+        self.track.trim(tr.pos, c.length_m)
+        if all(mv[0] == OUTSIDE for mv in tr.pos.moves):
+            tr.state = "left"
+            self.notify("train", f"train {tr.name} has left the station")
+            del self.trains[tr.name]
+        del moved
+
+    def _target(self, tr: Train) -> tuple[float, str]:
+        c = tr.consist
+        vmax = c.vmax_kmh / 3.6
+        if tr.mode == "manual":
+            return min(abs(tr.commanded_kmh) / 3.6, vmax), "driver"
+        rules = driving_rules()
+        horizon = tr.speed_ms ** 2 / (2 * c.brake_ms2) + 400.0
+        margin = rules.shunt_margin_m if tr.mode == "auto" else rules.stop_margin_m
+        ahead = look_ahead(self.track, tr.pos, self.station, self.aspects(), horizon, margin,
+                           shunting=tr.shunting, boundary_stops=tr.mode == "auto")
+        v, why = target_speed(tr.aspect_limit_ms, vmax, ahead, c.brake_ms2, lead_m=tr.speed_ms * self.dt)
+        if tr.mode == "auto" and self.auto_limit is not None:
+            extra = self.auto_limit(tr)
+            if extra is not None and extra[0] < v:
+                v, why = extra
+        return v, why
+
+    def _exact_stop(self, tr: Train) -> float | None:
+        """Distance to the point the train must stop at, if it is stopping there this step."""
+        ps = tr.platform_stop
+        if ps is not None and ps.state == "approaching" and tr.mode != "manual":
+            d = self._distance_to_x(tr, ps.stop_x)
+            if d is not None and d >= 0:
+                return d
+        return None
+
+    def _note_signals_passed(self, tr: Train, ds: float) -> None:
+        rules = driving_rules()
+        aspects = self.aspects()
+        for dist, node, _ in self.track.ahead(tr.pos, ds):
+            if dist > ds:
+                break
+            for sig in self.station.signals_at(node):
+                if sig.direction is tr.direction and (sig.kind.value == "shunting") == tr.shunting:
+                    aspect = aspects.get(sig.id, "")
+                    limit = rules.aspect_speed_kmh.get(aspect)
+                    tr.aspect_limit_ms = 1e9 if limit is None else limit / 3.6
+                    if aspect in ("H", "A", ""):
+                        self.notify("train", f"train {tr.name} passed signal {sig.id} at {aspect or 'dark'}")
+
+    # ---- platform stop and doors (seed 003) ----------------------------------------------------------------------
+    def set_platform_stop(self, tr: Train, platform: str) -> str:
+        p = next((p for p in self.station.model.platforms if p.id == platform), None)
+        if p is None:
+            return f"there is no platform '{platform}'"
+        tracks = self.station.section_tracks[p.section]
+        lo = min(self.station.track_span(t)[0] for t in tracks)
+        hi = max(self.station.track_span(t)[1] for t in tracks)
+        margin = 20.0  # the stopping mark stands short of the starting signal
+        stop = next((m.at for m in self.station.model.markers if m.kind.value == "stop" and m.track in tracks), None)
+        if stop is None:
+            stop = hi - margin if tr.direction is Direction.down else lo + margin
+        keys = tuple(f"{p.id}:{d.side.value}" for d in p.screen_doors)
+        tr.platform_stop = PlatformStop(p.id, p.section, keys, p.stop_window_m, stop_x=stop)
+        return ""
+
+    def _distance_to_x(self, tr: Train, x: float) -> float | None:
+        """Distance from the train's front to position ``x`` along the rails ahead (negative: just passed)."""
+        for start, move in self.track.moves_ahead(tr.pos, 3000.0):
+            s = self.track.s_of_x(move, x)
+            if s is not None and (start + s >= -tr.consist.length_m or start >= 0):
+                return start + s
+        return None
+
+    def _platform(self, tr: Train, target: float, why: str) -> tuple[float, str]:
+        ps = tr.platform_stop
+        assert ps is not None
+        if ps.state == "approaching":
+            d = self._distance_to_x(tr, ps.stop_x)
+            if d is None:
+                return target, why
+            if d < -ps.window_m:
+                ps.state = "missed"
+                self.notify("train", f"train {tr.name} overran the stopping window at {ps.platform}")
+                return target, why
+            if abs(d) <= ps.window_m and tr.speed_ms < 0.05:
+                ps.state = "stopped"
+                self.notify("train", f"train {tr.name} stopped at platform {ps.platform}, {d:+.2f} m from the mark "
+                            f"(window ±{ps.window_m:g} m): door-open permission "
+                            f"{', '.join(k.split(':')[1] for k in ps.door_keys) or 'none'}")
+                return 0.0, f"platform {ps.platform}"
+            v = stopping_speed(max(d, 0.0), tr.consist.brake_ms2)
+            return (v, f"platform {ps.platform}") if v < target else (target, why)
+        if ps.state in ("stopped", "doors_open", "closing"):
+            return 0.0, f"platform {ps.platform} ({ps.state})"
+        return target, why
+
+    # ---- what the track circuits and front ends see -----------------------------------------------------------
+    def axles(self) -> list[Axle]:
+        out: list[Axle] = []
+        for tr in self.trains.values():
+            out += self.track.axles(tr.pos, tr.consist.axle_offsets_m)
+        return out
+
+    def sections_of(self, tr: Train) -> tuple[str, ...]:
+        secs: list[str] = []
+        for a in self.track.axles(tr.pos, tr.consist.axle_offsets_m):
+            s = self.station.tracks[a.track].section
+            if s not in secs:
+                secs.append(s)
+        return tuple(secs)
+
+    def front(self, tr: Train) -> tuple[str, float]:
+        move = tr.pos.moves[-1]
+        if move[0] == OUTSIDE:
+            return OUTSIDE, 0.0
+        return move[0], self.track.x_at(move, tr.pos.front_s)
+
+
+__all__ = ["MODES", "Fleet", "PlatformStop", "Train"]
