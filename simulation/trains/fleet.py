@@ -16,6 +16,7 @@ from stations.station import Station
 
 from .consist import Consist
 from .drivers import driving_rules, look_ahead, stopping_speed, target_speed
+from .engine import KinematicEngine, MotionEngine
 from .movement import OUTSIDE, Notify, Position, Track
 
 MODES = ("manual", "signal", "auto")
@@ -68,8 +69,10 @@ class Fleet:
     """Every train of one simulation."""
 
     def __init__(self, station: Station, fld: Field, aspects: Aspects, notify: Notify,
-                 auto_limit: Callable[[Train], tuple[float, str] | None] | None = None) -> None:
+                 auto_limit: Callable[[Train], tuple[float, str] | None] | None = None,
+                 engine: MotionEngine | None = None) -> None:
         self.auto_limit = auto_limit
+        self.engine: MotionEngine = engine or KinematicEngine()
         self.station = station
         self.field = fld
         self.track = Track(station, fld)
@@ -85,49 +88,56 @@ class Fleet:
         pos = self.track.place(section, direction, consist.length_m, back_m)
         if isinstance(pos, str):
             return pos
+        why = self.engine.add(name, consist, 0.0)
+        if why:
+            return why
         train = Train(name, consist, pos, mode)
         self.trains[name] = train
         return ""
 
     def remove(self, name: str) -> None:
         self.trains.pop(name, None)
+        self.engine.remove(name)
 
     # ---- stepping ----------------------------------------------------------------------------------------------
     def step(self, dt: float) -> None:
         self.t += dt
         self.dt = dt
-        for train in list(self.trains.values()):
-            self._step_train(train, dt)
+        targets: dict[str, float] = {}
+        limits: dict[str, float] = {}
+        for tr in self.trains.values():
+            if tr.state in ("derailed", "left"):
+                continue
+            target, why = self._target(tr)
+            if tr.platform_stop is not None and tr.mode != "manual":
+                target, why = self._platform(tr, target, why)
+            tr.why = why
+            targets[tr.name] = target
+            stop_at = self._exact_stop(tr)
+            if stop_at is not None:
+                limits[tr.name] = stop_at
+        motion = self.engine.step(dt, targets, limits)
+        for name, (speed, ds) in motion.items():
+            tr = self.trains.get(name)
+            if tr is not None:
+                tr.speed_ms = speed
+                self._move(tr, ds)
 
-    def _step_train(self, tr: Train, dt: float) -> None:
-        if tr.state in ("derailed", "left"):
-            return
+    def _move(self, tr: Train, ds: float) -> None:
         c = tr.consist
-        target, why = self._target(tr)
-        if tr.platform_stop is not None and tr.mode != "manual":
-            target, why = self._platform(tr, target, why)
-        tr.why = why
-        if tr.speed_ms < target:
-            tr.speed_ms = min(target, tr.speed_ms + c.accel_ms2 * dt)
-        else:
-            tr.speed_ms = max(target, tr.speed_ms - c.brake_ms2 * dt)
-        ds = tr.speed_ms * dt
         if ds <= 0.0:
             return
-        stop_at = self._exact_stop(tr)
-        if stop_at is not None and ds >= stop_at:
-            ds = max(stop_at, 0.0)  # reach the stopping point exactly rather than overshoot by a step
-            tr.speed_ms = 0.0
         self._note_signals_passed(tr, ds)
         moved, stop = self.track.advance(tr.name, tr.pos, ds, self.notify)
         if stop:
             tr.speed_ms = 0.0
+            self.engine.set_speed(tr.name, 0.0)
             tr.state = "derailed" if stop == "derailed" else "running"
         self.track.trim(tr.pos, c.length_m)
         if all(mv[0] == OUTSIDE for mv in tr.pos.moves):
             tr.state = "left"
             self.notify("train", f"train {tr.name} has left the station")
-            del self.trains[tr.name]
+            self.remove(tr.name)
         del moved
 
     def _target(self, tr: Train) -> tuple[float, str]:
