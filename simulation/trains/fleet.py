@@ -118,10 +118,10 @@ class Fleet:
                 limits[tr.name] = stop_at
         motion = self.engine.step(dt, targets, limits)
         for name, (speed, ds) in motion.items():
-            tr = self.trains.get(name)
-            if tr is not None:
-                tr.speed_ms = speed
-                self._move(tr, ds)
+            moving = self.trains.get(name)
+            if moving is not None:
+                moving.speed_ms = speed
+                self._move(moving, ds)
 
     def _move(self, tr: Train, ds: float) -> None:
         c = tr.consist
