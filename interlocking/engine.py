@@ -247,7 +247,12 @@ class Engine:
             self._sequential_release(rs)
 
     def _first_occupied(self, rs: RouteState) -> bool:
-        return not self.clear(rs.route.sections[0])
+        """A movement is in the first section. With the approach clear an occupied first section is a track-circuit
+        fault (red band), as ``_keep_open`` judges it, not a movement entering: the route stays locked."""
+        r = rs.route
+        if self.clear(r.sections[0]):
+            return False
+        return not (r.approach and all(self.clear(s) for s in r.approach))
 
     def open_blocker(self, rs: RouteState, *, guide: bool = False) -> str:
         """Why the signal of ``rs`` may not open (or stay open); '' when every condition holds."""
