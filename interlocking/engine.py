@@ -363,7 +363,8 @@ class Engine:
         if rs.guide:
             self._keep_guide(rs)
             return
-        if not self.clear(r.sections[0]) and r.approach and all(self.clear(s) for s in r.approach):
+        if (not rs.entered and not self.clear(r.sections[0]) and r.approach
+                and all(self.clear(s) for s in r.approach)):
             # occupied with nobody approaching: a track-circuit fault (red band), not a train entering
             self.close_signal(rs, f"section {r.sections[0]} is occupied", abnormal=True)
             return

@@ -99,10 +99,10 @@ class Simulation:
 
         return auto_limit(self, train)
 
-    def attach_auto(self, train: Train, plan: list[str]) -> Result:
+    def attach_auto(self, train: Train, plan: list[str], flags: dict[str, bool] | None = None) -> Result:
         from .trains.automatic import attach
 
-        return attach(self, train, plan)
+        return attach(self, train, plan, flags)
 
     def _platforms(self) -> None:
         from .trains.ato import platform_doors

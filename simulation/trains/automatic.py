@@ -16,12 +16,24 @@ from typing import TYPE_CHECKING
 from interlocking.io import Result
 from interlocking.state import RouteStage
 
-from .autoshunt import EmergencyStops, ShuntingInputs, depot_speed_limit_kmh, driving_conditions, entry_conditions
+from .autoshunt import (
+    ONE_STOP_WINDOW_M,
+    ShuntingInputs,
+    permitted_speed_kmh,
+    driving_conditions,
+    entry_conditions,
+)
 from .drivers import driving_rules
 from .fleet import Train
 
 if TYPE_CHECKING:
     from ..sim import Simulation
+
+ONE_STOP_MARGIN_M = 1.0  # the front comes to a stand this far short of a one-stop point
+
+# condition flags an instructor can set with 'auto NAME key=on|off'
+FLAGS = {"onboard": "authorised_onboard", "centre": "authorised_centre", "loco": "loco_healthy",
+         "perception": "perception_healthy"}
 
 
 @dataclass
@@ -32,7 +44,6 @@ class AutoController:
     authorised_centre: bool = True
     loco_healthy: bool = True
     perception_healthy: bool = True
-    estops: EmergencyStops = field(default_factory=EmergencyStops)
     one_stops_done: set[str] = field(default_factory=set)
     requested: str = ""  # the plan route last asked of the interlocking
     unmet: list[str] = field(default_factory=list)
@@ -60,6 +71,10 @@ def inputs_for(sim: Simulation, tr: Train, ctl: AutoController) -> ShuntingInput
     front_track, _ = sim.fleet.front(tr)
     front_section = sim.station.tracks[front_track].section if front_track in sim.station.tracks else ""
     in_route = front_section in il.section_lock
+    if not in_route and front_section and sim.station.sections[front_section].role.value in ("spur", "station_track"):
+        # on a depot or station track beyond the end of its route: the movement goes on under the shunting order up
+        # to a safe distance before the next signal or buffer stop (the track holds no turnouts to lock)
+        in_route = True
     aspect = sim.aspect(sig) if sig else ""
     plan_route = ctl.current
     return ShuntingInputs(
@@ -92,8 +107,15 @@ def _obstacle(sim: Simulation, tr: Train) -> float | None:
     return best
 
 
-def attach(sim: Simulation, tr: Train, plan: list[str]) -> Result:
-    ctl = AutoController(plan)
+def attach(sim: Simulation, tr: Train, plan: list[str], flags: dict[str, bool] | None = None) -> Result:
+    """Switch ``tr`` to automatic shunting (or, if it already is, update its plan and condition flags)."""
+    ctl = tr.controller if isinstance(tr.controller, AutoController) else AutoController(plan)
+    if plan:
+        ctl.plan, ctl.step, ctl.requested = plan, 0, ""
+    for key, value in (flags or {}).items():
+        setattr(ctl, FLAGS[key], value)
+    if tr.controller is ctl and tr.mode == "auto":
+        return Result.accept(f"train {tr.name}: automatic shunting updated")
     unmet = entry_conditions(inputs_for(sim, tr, ctl))
     if unmet:
         return Result.refuse(f"train {tr.name} cannot enter automatic mode: {'; '.join(unmet)}")
@@ -137,8 +159,6 @@ def auto_limit(sim: Simulation, tr: Train) -> tuple[float, str] | None:
         return None
     centre(sim, tr)
     unmet = driving_conditions(inputs_for(sim, tr, ctl))
-    if ctl.estops.stopped:
-        unmet = [f"emergency stop ({', '.join(sorted(ctl.estops.active))})", *unmet]
     if unmet != ctl.unmet and unmet:
         sim.log("train", f"train {tr.name} braked: {'; '.join(unmet)}")
     ctl.unmet = unmet
@@ -146,10 +166,13 @@ def auto_limit(sim: Simulation, tr: Train) -> tuple[float, str] | None:
         return 0.0, unmet[0]
     axles = sim.fleet.track.axles(tr.pos, tr.consist.axle_offsets_m)
     _, x = sim.fleet.front(tr)
-    tracks = {a.track for a in axles}
+    tracks = {a.track for a in axles} | {m[0] for _, m in sim.fleet.track.moves_ahead(tr.pos, 100.0)}
     rear = axles[-1].x if axles else x
-    limit = depot_speed_limit_kmh(x, sim.station.model.markers, rear_m=rear, tracks=tracks) / 3.6
+    # the limit here and the braking curves to the restricted stretches ahead (seed 000: 8 km/h, 3 km/h)
+    limit = permitted_speed_kmh(x, tr.direction.value, sim.station.model.markers, rear_m=rear, tracks=tracks,
+                                decel_ms2=tr.consist.brake_ms2) / 3.6
     why = f"depot limit {limit * 3.6:g} km/h"
+    tr.extra.pop("stop_at", None)
     for mk in sim.station.model.markers:
         if mk.kind.value != "one-stop" or mk.id in ctl.one_stops_done:
             continue
@@ -159,12 +182,15 @@ def auto_limit(sim: Simulation, tr: Train) -> tuple[float, str] | None:
             s = sim.fleet.track.s_of_x(move, mk.at)
             if s is None:
                 continue
-            d = start + s - driving_rules().buffer_margin_m
-            if d <= 0.5 and tr.speed_ms < 0.05:
-                ctl.one_stops_done.add(mk.id)
-                sim.log("train", f"train {tr.name} stopped at one-stop point {mk.id}")
-            elif d > 0:
-                v = (2 * tr.consist.brake_ms2 * d) ** 0.5
+            d = start + s - ONE_STOP_MARGIN_M  # the front stops just short of the point
+            if d <= ONE_STOP_WINDOW_M and tr.speed_ms < 0.05:
+                ctl.one_stops_done.add(mk.id)  # a stand this close before the point is the stop there
+                sim.log("train", f"train {tr.name} stopped at one-stop point {mk.id} ({d + ONE_STOP_MARGIN_M:.1f} m "
+                        "short of it)")
+            elif d > -ONE_STOP_MARGIN_M:
+                tr.extra["stop_at"] = max(d, 0.0)
+                v = (2 * tr.consist.brake_ms2 * max(d, 0.0)) ** 0.5
                 if v < limit:
                     limit, why = v, f"one-stop point {mk.id}"
+            break
     return limit, why

@@ -22,7 +22,10 @@ USAGE = {
              "| train NAME remove",
     "drive": "drive NAME SPEED (km/h; manual driving, overrides automatic)",
     "stop": "stop NAME",
-    "auto": "auto NAME [plan=ROUTE,ROUTE,...]",
+    "auto": "auto NAME [plan=ROUTE,ROUTE,...] [onboard=on|off] [centre=on|off] [loco=ok|fault] "
+            "[perception=ok|fault]",
+    "estop": "estop NAME SOURCE (team, cab, remote, system)",
+    "estop-release": "estop-release NAME SOURCE [by=SOURCE]",
     "reverse": "reverse NAME (change the direction of travel; the train must stand)",
 }
 
@@ -84,7 +87,10 @@ def _train(sim: Simulation, args: list[str]) -> Result:
             sim.fleet.remove(name)
             return Result.refuse(f"train {name}: {why}")
     if mode == "auto":
-        sim.attach_auto(tr, [])
+        result = sim.attach_auto(tr, [])
+        if not result.ok:
+            sim.fleet.remove(name)
+            return result
     sim.update_axles()
     sim.log("train", f"train {name} placed in {section}: {consist.axles} wheelsets, {consist.length_m:g} m, "
             f"{mode}, {direction}")
@@ -149,15 +155,48 @@ def _auto(sim: Simulation, args: list[str]) -> Result:
     if name not in sim.fleet.trains:
         return Result.refuse(f"there is no train '{name}'")
     plan: list[str] = []
+    flags: dict[str, bool] = {}
+    words = {"on": True, "ok": True, "off": False, "fault": False}
     for o in args[1:]:
         k, eq, v = o.partition("=")
-        if k != "plan" or not eq:
+        if k == "plan" and eq:
+            plan = [p for p in v.split(",") if p]
+            unknown = [p for p in plan if p not in sim.table.routes]
+            if unknown:
+                return Result.refuse(f"the plan names routes that do not exist: {', '.join(unknown)}")
+        elif k in ("onboard", "centre", "loco", "perception") and v in words:
+            flags[k] = words[v]
+        else:
             return Result.refuse(f"usage: {USAGE['auto']}")
-        plan = [p for p in v.split(",") if p]
-        unknown = [p for p in plan if p not in sim.table.routes]
-        if unknown:
-            return Result.refuse(f"the plan names routes that do not exist: {', '.join(unknown)}")
-    return sim.attach_auto(sim.fleet.trains[name], plan)
+    return sim.attach_auto(sim.fleet.trains[name], plan, flags)
+
+
+def _estop(sim: Simulation, args: list[str]) -> Result:
+    name, bad = _named(sim, args, "estop", 2)
+    if bad:
+        return bad
+    tr = sim.fleet.trains[name]
+    tr.estops.apply(args[1])
+    sim.log("train", f"train {name}: emergency stop from {args[1]}")
+    return Result.accept(f"train {name}: emergency stop from {args[1]}")
+
+
+def _estop_release(sim: Simulation, args: list[str]) -> Result:
+    if len(args) not in (2, 3):
+        return Result.refuse(f"usage: {USAGE['estop-release']}")
+    name, source = args[0], args[1]
+    if name not in sim.fleet.trains:
+        return Result.refuse(f"there is no train '{name}'")
+    by = source
+    if len(args) == 3:
+        k, eq, by = args[2].partition("=")
+        if k != "by" or not eq:
+            return Result.refuse(f"usage: {USAGE['estop-release']}")
+    why = sim.fleet.trains[name].estops.release(source, by)
+    if why:
+        return Result.refuse(why)
+    sim.log("train", f"train {name}: emergency stop from {source} released")
+    return Result.accept(f"train {name}: emergency stop from {source} released")
 
 
 def _reverse(sim: Simulation, args: list[str]) -> Result:
@@ -173,4 +212,4 @@ def _reverse(sim: Simulation, args: list[str]) -> Result:
 
 
 TRAIN_COMMANDS: dict[str, Handler] = {"train": _train, "drive": _drive, "stop": _stop, "auto": _auto,
-                                      "reverse": _reverse}
+                                      "reverse": _reverse, "estop": _estop, "estop-release": _estop_release}

@@ -14,6 +14,7 @@ from circuits.railgeometry import Axle
 from stations.schema import Direction
 from stations.station import Station
 
+from .autoshunt import EmergencyStops
 from .consist import Consist
 from .drivers import driving_rules, look_ahead, stopping_speed, target_speed
 from .engine import KinematicEngine, MotionEngine
@@ -51,6 +52,7 @@ class Train:
     train_doors_open: bool = False
     controller: object | None = None  # the automatic shunting controller, when in auto mode
     shunting: bool = False  # a shunting movement (heeds shunting signals) rather than a train movement
+    estops: EmergencyStops = field(default_factory=EmergencyStops)  # emergency stops by source (seed 002)
     extra: dict[str, object] = field(default_factory=dict)
 
     @property
@@ -141,6 +143,8 @@ class Fleet:
         del moved
 
     def _target(self, tr: Train) -> tuple[float, str]:
+        if tr.estops.stopped:  # an emergency stop outranks everything, the driver's traction too
+            return 0.0, "emergency stop (" + ", ".join(sorted(tr.estops.active)) + ")"
         c = tr.consist
         vmax = c.vmax_kmh / 3.6
         if tr.mode == "manual":
@@ -164,7 +168,8 @@ class Fleet:
             d = self._distance_to_x(tr, ps.stop_x)
             if d is not None and d >= 0:
                 return d
-        return None
+        stop = tr.extra.get("stop_at") if tr.mode == "auto" else None
+        return float(stop) if isinstance(stop, float | int) else None
 
     def _note_signals_passed(self, tr: Train, ds: float) -> None:
         rules = driving_rules()
