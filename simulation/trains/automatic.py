@@ -19,11 +19,10 @@ from interlocking.state import RouteStage
 from .autoshunt import (
     ONE_STOP_WINDOW_M,
     ShuntingInputs,
-    permitted_speed_kmh,
     driving_conditions,
     entry_conditions,
+    permitted_speed_kmh,
 )
-from .drivers import driving_rules
 from .fleet import Train
 
 if TYPE_CHECKING:
