@@ -17,8 +17,8 @@ if TYPE_CHECKING:
 Handler = Callable[["Simulation", list[str]], Result]
 
 USAGE = {
-    "train": "train NAME at SECTION [kind=freight|emu|shunter|trolley] [length=M] [axles=N] [vmax=KMH] "
-             "[mode=manual|signal|auto] [dir=down|up] [movement=train|shunt] [back=M] [stop=PLATFORM] "
+    "train": "train NAME at SECTION|TRACK [kind=freight|emu|shunter|trolley] [length=M] [axles=N] [vmax=KMH] "
+             "[mode=manual|signal|auto] [dir=down|up] [movement=train|shunt] [back=M] [front=X] [stop=PLATFORM] "
              "| train NAME remove",
     "drive": "drive NAME SPEED (km/h; manual driving, overrides automatic)",
     "stop": "stop NAME",
@@ -44,25 +44,25 @@ def _train(sim: Simulation, args: list[str]) -> Result:
     name, _, section, *opts = args
     if name in sim.fleet.trains:
         return Result.refuse(f"train {name} is already on the track; 'train {name} remove' first")
-    if section not in sim.station.sections:
+    if section not in sim.station.sections and section not in sim.station.tracks:
         return Result.refuse(f"there is no section '{section}' at {sim.station.id}")
     params: dict[str, str] = {}
     for o in opts:
         k, eq, v = o.partition("=")
-        if not eq or k not in ("kind", "length", "axles", "vmax", "mode", "dir", "stop", "movement", "back"):
+        if not eq or k not in ("kind", "length", "axles", "vmax", "mode", "dir", "stop", "movement", "back", "front"):
             return Result.refuse(f"unknown train parameter '{o}'; usage: {USAGE['train']}")
         params[k] = v
     kind = params.get("kind", "freight")
     if kind not in ("freight", "emu", "shunter", "trolley"):
         return Result.refuse("kind must be freight, emu, shunter or trolley")
     nums: dict[str, float] = {}
-    for k in ("length", "axles", "vmax", "back"):
+    for k in ("length", "axles", "vmax", "back", "front"):
         if k in params:
             try:
                 nums[k] = float(params[k])
             except ValueError:
                 return Result.refuse(f"{k} must be a number, not '{params[k]}'")
-            if nums[k] <= 0:
+            if nums[k] <= 0 and k != "front":
                 return Result.refuse(f"{k} must be positive")
     mode = params.get("mode", "manual")
     if mode not in MODES:
@@ -72,7 +72,8 @@ def _train(sim: Simulation, args: list[str]) -> Result:
         return Result.refuse("dir must be down or up")
     consist = make_consist(kind, length_m=nums.get("length"), axles=int(nums["axles"]) if "axles" in nums else None,
                            vmax_kmh=nums.get("vmax"))
-    why = sim.fleet.place(name, consist, section, Direction(direction), mode, nums.get("back", 5.0))
+    why = sim.fleet.place(name, consist, section, Direction(direction), mode, nums.get("back", 5.0),
+                          nums.get("front"))
     if why:
         return Result.refuse(f"train {name}: {why}")
     tr = sim.fleet.trains[name]

@@ -86,8 +86,8 @@ class Fleet:
 
     # ---- placing -------------------------------------------------------------------------------------------------
     def place(self, name: str, consist: Consist, section: str, direction: Direction, mode: str,
-              back_m: float = 5.0) -> str:
-        pos = self.track.place(section, direction, consist.length_m, back_m)
+              back_m: float = 5.0, front_x: float | None = None) -> str:
+        pos = self.track.place(section, direction, consist.length_m, back_m, front_x)
         if isinstance(pos, str):
             return pos
         why = self.engine.add(name, consist, 0.0)

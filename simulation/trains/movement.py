@@ -51,20 +51,32 @@ class Track:
         frac = s / self.station.track_length(track)
         return lo + (hi - lo) * frac if d is Direction.down else hi - (hi - lo) * frac
 
-    def place(self, section: str, direction: Direction, length: float, front_back_m: float = 5.0) -> Position | str:
-        """A train of ``length`` standing in ``section`` facing ``direction``, its front ``front_back_m`` short of the
-        section's far end; its rear may reach back into the sections behind. Returns the reason if it does not fit."""
-        tracks = self.station.section_tracks.get(section)
-        if not tracks:
-            return f"there is no section '{section}'"
-        # the section's track furthest in the direction of travel that continues backwards inside the model
-        key = (lambda t: self.station.track_span(t)[1]) if direction is Direction.down else (
-            lambda t: -self.station.track_span(t)[0])
-        front_track = max(tracks, key=key)
+    def place(self, section: str, direction: Direction, length: float, front_back_m: float = 5.0,
+              front_x: float | None = None) -> Position | str:
+        """A train of ``length`` standing in ``section`` (or on a track) facing ``direction``, its front
+        ``front_back_m`` short of the far end (or at position ``front_x`` along the line); its rear may reach back
+        into the sections behind, and beyond a boundary onto the open line. Returns the reason if it does not fit."""
+        if section in self.station.tracks:
+            front_track = section
+        else:
+            tracks = self.station.section_tracks.get(section)
+            if not tracks:
+                return f"there is no section or track '{section}'"
+            # the section's track furthest in the direction of travel
+            key = (lambda t: self.station.track_span(t)[1]) if direction is Direction.down else (
+                lambda t: -self.station.track_span(t)[0])
+            front_track = max(tracks, key=key)
         move: Move = (front_track, direction)
-        if front_back_m >= self.length(move):
+        if front_x is not None:
+            s_x = self.s_of_x(move, front_x)
+            if s_x is None:
+                lo, hi = self.station.track_span(front_track)
+                return f"front={front_x:g} is off track {front_track} ({lo:g}-{hi:g} m)"
+            front_s = s_x
+        elif front_back_m >= self.length(move):
             return f"{section} is only {self.length(move):.0f} m long where the train would stand; use a smaller back="
-        front_s = self.length(move) - front_back_m
+        else:
+            front_s = self.length(move) - front_back_m
         moves = [move]
         need = length - front_s
         while need > 0:
