@@ -1,0 +1,1 @@
+"""Trains: consists, kinematics, drivers, automatic shunting and odometry."""

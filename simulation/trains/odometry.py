@@ -1,0 +1,323 @@
+"""Speed and distance measurement of a shunting locomotive (测速测距), after seed 001.
+
+The tacho (光电速度传感器) turns wheel revolutions into pulses; over a sampling time ``t`` with ``n`` pulses the speed
+is ``v = pi * d * n / (N * t)`` (``d`` wheel diameter, ``N`` pulses per revolution). A wheel that spins (空转, slip)
+or locks (打滑, slide) makes the tacho lie: the tacho's acceleration jumps above ``a_max`` (slip) or below ``a_min``
+(slide), both configurable from the vehicle's performance and the gradients. While it lies, the odometer goes back
+to the speed before the episode and integrates a compensated acceleration instead (the accelerometer, less the
+gradient term, else the last plausible acceleration), until the wheel agrees again. Balises and RFID tags give the
+absolute position (``correct``); so does a track section in the direction of travel going from locked to occupied
+(``section_transition``). An error made in the last section before a stopping point cannot be corrected any more,
+and a slide there leaves the measured position short of the true one: the dangerous side.
+
+``simulate_run`` scripts a run with a slip while accelerating and a slide while braking, seed 001's test runs.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+from dataclasses import dataclass, field
+from typing import Any, Literal, NamedTuple
+
+G = 9.81
+State = Literal["normal", "slip", "slide"]
+
+
+@dataclass(frozen=True)
+class Correction:
+    t: float
+    kind: str  # "balise" (balise or RFID tag) or "section" (section ahead locked -> occupied)
+    before_m: float
+    after_m: float
+
+
+class _Sample(NamedTuple):
+    t: float
+    wheel_ms: float  # tacho speed over the window
+    est_ms: float  # estimated speed
+    position_m: float
+    accel_ms2: float  # tacho acceleration
+
+
+class Odometer:
+    """Tacho odometry with slip/slide detection and compensation.
+
+    ``wheel_diameter_m`` and ``pulses_per_rev`` as for a shunting locomotive; ``a_max`` / ``a_min`` (m/s2) are the
+    slip and slide thresholds (the seed leaves them configurable: above what the locomotive can do on the steepest
+    gradient); ``window_s`` the time over which the tacho speed ``pi d n / (N t)`` and its acceleration are taken;
+    an episode ends when the tacho agrees with the estimate for ``recover_s`` (within ``recover_tol_ms`` plus
+    ``drift_ms2`` per second of compensation, for the accelerometer's drift), or after ``max_compensation_s`` (the
+    seed's n_max). ``compensate=False`` gives the plain odometer that trusts the wheel.
+    ``position_m`` is the running position along the movement's path, increasing as the locomotive runs.
+    """
+
+    def __init__(self, wheel_diameter_m: float = 1.05, pulses_per_rev: int = 200, a_max: float = 0.6,
+                 a_min: float = -1.2, *, window_s: float = 0.5, recover_s: float = 0.5, recover_tol_ms: float = 0.1,
+                 drift_ms2: float = 0.05, max_compensation_s: float = 10.0, compensate: bool = True,
+                 position_m: float = 0.0) -> None:
+        if wheel_diameter_m <= 0 or pulses_per_rev <= 0 or a_max <= 0 or a_min >= 0:
+            raise ValueError("need d > 0, N > 0, a_max > 0 and a_min < 0")
+        self.wheel_diameter_m = wheel_diameter_m
+        self.pulses_per_rev = pulses_per_rev
+        self.a_max, self.a_min = a_max, a_min
+        self.window_s, self.recover_s, self.recover_tol_ms = window_s, recover_s, recover_tol_ms
+        self.drift_ms2 = drift_ms2
+        self.max_compensation_s = max_compensation_s
+        self.compensate = compensate
+        self.t = 0.0
+        self._position = position_m
+        self._speed = 0.0  # the speed given out
+        self._est = 0.0  # speed estimate now (the window speed lags by half a window; given out when compensating)
+        self._hold = 0.0  # plausible acceleration before the episode, used without an accelerometer
+        self._state: State = "normal"
+        self._win: deque[tuple[float, int]] = deque()  # (dt, pulses) over the window
+        self._hist: deque[_Sample] = deque()
+        self._carry = 0.0  # fraction of a pulse (update())
+        self._episode_t = 0.0
+        self._agree_t = 0.0
+        self.episodes: list[tuple[float, State]] = []  # (start time, kind)
+        self.corrections: list[Correction] = []
+
+    # ---- readings -------------------------------------------------------------------------------------------
+    @property
+    def metres_per_pulse(self) -> float:
+        return math.pi * self.wheel_diameter_m / self.pulses_per_rev
+
+    @property
+    def position_m(self) -> float:
+        return self._position
+
+    @property
+    def speed_ms(self) -> float:
+        return self._speed
+
+    @property
+    def slipping(self) -> bool:
+        return self._state == "slip"
+
+    @property
+    def sliding(self) -> bool:
+        return self._state == "slide"
+
+    def error_m(self, true_position_m: float) -> float:
+        """Measured minus true position; negative means the locomotive is further on than it believes."""
+        return self._position - true_position_m
+
+    # ---- inputs ---------------------------------------------------------------------------------------------
+    def update(self, dt: float, wheel_speed_ms: float, accel_ms2: float | None = None,
+               gradient_permille: float = 0.0) -> None:
+        """One sampling interval of a wheel turning at ``wheel_speed_ms``: the tacho gives whole pulses."""
+        self._carry += max(wheel_speed_ms, 0.0) * dt / self.metres_per_pulse
+        count = int(self._carry)
+        self._carry -= count
+        self.pulses(count, dt, accel_ms2, gradient_permille)
+
+    def pulses(self, count: int, dt: float, accel_ms2: float | None = None, gradient_permille: float = 0.0) -> None:
+        """``count`` tacho pulses in ``dt`` seconds; ``accel_ms2`` the accelerometer (which also feels the gradient,
+        ``gradient_permille`` rising in the direction of travel: from the line data, or the steepest as a bound)."""
+        if dt <= 0 or count < 0:
+            raise ValueError("need dt > 0 and count >= 0")
+        self.t += dt
+        self._win.append((dt, count))
+        while len(self._win) > 1 and sum(d for d, _ in self._win) - self._win[0][0] >= self.window_s - 1e-9:
+            self._win.popleft()
+        span = sum(d for d, _ in self._win)
+        wheel = math.pi * self.wheel_diameter_m * sum(n for _, n in self._win) / (self.pulses_per_rev * span)
+        ref = next((h for h in reversed(self._hist) if h.t <= self.t - self.window_s + 1e-9), None)
+        a_wheel = (wheel - ref.wheel_ms) / (self.t - ref.t) if ref is not None else 0.0
+        a_comp = self._hold if accel_ms2 is None else accel_ms2 - G * gradient_permille / 1000.0
+        step = count * self.metres_per_pulse
+        if self._state == "normal":
+            kind: State | None = "slip" if a_wheel > self.a_max else "slide" if a_wheel < self.a_min else None
+            if kind is None or ref is None:
+                self._est = wheel + self._hold * self.window_s / 2
+                self._hold = min(max(a_wheel, self.a_min), self.a_max)
+                self._position += step
+            else:
+                self._begin(kind, self._hist[0], accel_ms2, gradient_permille, step)
+        else:
+            before = self._est
+            self._est = max(0.0, self._est + a_comp * dt)
+            if self._state == "slip":  # a spinning wheel runs faster than the locomotive: an upper bound
+                self._est = min(self._est, (count + 1) * self.metres_per_pulse / dt)
+            else:  # a locked wheel runs slower: a lower bound
+                self._est = max(self._est, (count - 1) * self.metres_per_pulse / dt)
+            self._position += (before + self._est) / 2 * dt if self.compensate else step
+            self._episode_t += dt
+            lagged = self._est - a_comp * self.window_s / 2  # what the window speed should read
+            tol = self.recover_tol_ms + self.drift_ms2 * self._episode_t
+            agree = abs(wheel - lagged) <= tol or (wheel == 0.0 and self._est == 0.0)
+            self._agree_t = self._agree_t + dt if agree else 0.0
+            if self._agree_t >= self.recover_s or self._episode_t >= self.max_compensation_s:
+                self._state = "normal"
+        self._speed = self._est if self.compensate and self._state != "normal" else wheel
+        self._hist.append(_Sample(self.t, wheel, self._est, self._position, a_wheel))
+        while len(self._hist) > 1 and self._hist[1].t <= self.t - 2 * self.window_s + 1e-9:
+            self._hist.popleft()
+
+    def _begin(self, kind: State, ref: _Sample, accel_ms2: float | None, gradient_permille: float,
+               step: float) -> None:
+        """An episode starts: go back to the sample before the tacho went wrong and integrate from there."""
+        self._state = kind
+        self._episode_t = self._agree_t = 0.0
+        self.episodes.append((self.t, kind))
+        before = [h.accel_ms2 for h in self._hist if h.t <= self.t - self.window_s + 1e-9] or [ref.accel_ms2]
+        self._hold = min(max(sum(before) / len(before), self.a_min), self.a_max)  # the acceleration before it
+        a = self._hold if accel_ms2 is None else accel_ms2 - G * gradient_permille / 1000.0
+        span = self.t - ref.t
+        self._est = max(0.0, ref.est_ms + a * span)
+        if self.compensate:
+            self._position = ref.position_m + (ref.est_ms + self._est) / 2 * span
+        else:
+            self._position += step
+
+    # ---- absolute corrections -------------------------------------------------------------------------------
+    def correct(self, position_m: float, kind: str = "balise", *, since_s: float = 0.0) -> float:
+        """A balise or RFID tag at ``position_m`` was passed ``since_s`` ago (the reader's time stamp, or its fixed
+        response delay): take it as the position. Returns the correction (m)."""
+        new = position_m + self._speed * since_s
+        self.corrections.append(Correction(self.t, kind, self._position, new))
+        delta = new - self._position
+        self._position = new
+        for i, s in enumerate(self._hist):
+            self._hist[i] = s._replace(position_m=s.position_m + delta)
+        return delta
+
+    def section_transition(self, position_m: float, *, since_s: float = 0.0) -> float:
+        """The section in the direction of travel went from locked to occupied: the leading wheelset is at its
+        joint ``position_m`` (the running position of that joint on the movement's path)."""
+        return self.correct(position_m, "section", since_s=since_s)
+
+
+# ---- a scripted run --------------------------------------------------------------------------------------------
+@dataclass
+class RunResult:
+    """Time series of a scripted run; ``measured`` with compensation, ``naive`` trusting the wheel; both get the
+    same balise and section corrections."""
+
+    t: list[float] = field(default_factory=list)
+    true_m: list[float] = field(default_factory=list)
+    measured_m: list[float] = field(default_factory=list)
+    naive_m: list[float] = field(default_factory=list)
+    true_ms: list[float] = field(default_factory=list)
+    wheel_ms: list[float] = field(default_factory=list)
+    slipping: list[bool] = field(default_factory=list)
+    sliding: list[bool] = field(default_factory=list)
+    corrections: list[Correction] = field(default_factory=list)
+    naive_corrections: list[Correction] = field(default_factory=list)
+    stop_m: float = 0.0
+    last_section_m: float = 0.0  # where the last section before the stopping point begins
+
+    @property
+    def error_m(self) -> list[float]:
+        return [m - x for m, x in zip(self.measured_m, self.true_m, strict=True)]
+
+    @property
+    def naive_error_m(self) -> list[float]:
+        return [m - x for m, x in zip(self.naive_m, self.true_m, strict=True)]
+
+    def figures(self) -> dict[str, float]:
+        """Max |error| with and without compensation over the run and before the first correction (the slip), the
+        first correction and the error just after it, and the residual at the stop, made in the last section."""
+        err, naive = self.error_m, self.naive_error_m
+        first = self.corrections[0].t if self.corrections else math.inf
+        pre = [i for i, t in enumerate(self.t) if t < first] or [0]
+        post = next((i for i, t in enumerate(self.t) if t >= first), len(self.t) - 1)
+        dt = self.t[1] - self.t[0] if len(self.t) > 1 else 0.0
+
+        def jump(cs: list[Correction]) -> float:
+            return cs[0].after_m - cs[0].before_m if cs else 0.0
+
+        return {
+            "max_error_m": max(map(abs, err)),
+            "max_error_naive_m": max(map(abs, naive)),
+            "slip_max_error_m": max(abs(err[i]) for i in pre),
+            "slip_max_error_naive_m": max(abs(naive[i]) for i in pre),
+            "first_correction_m": jump(self.corrections),
+            "first_correction_naive_m": jump(self.naive_corrections),
+            "after_correction_error_m": err[post],
+            "stop_error_m": err[-1],
+            "stop_error_naive_m": naive[-1],
+            "slip_s": sum(self.slipping) * dt,
+            "slide_s": sum(self.sliding) * dt,
+        }
+
+
+def _ramp(t: float, start: float, duration: float, rise: float) -> float:
+    """0 outside [start, start + duration], 1 inside, linear over ``rise`` seconds at both ends."""
+    if t <= start or t >= start + duration:
+        return 0.0
+    return min(1.0, (t - start) / rise, (start + duration - t) / rise)
+
+
+def simulate_run(*, length_m: float = 600.0, v_max_kmh: float = 20.0, accel_ms2: float = 0.28,
+                 decel_ms2: float = 0.37, dt: float = 0.1, slip: tuple[float, float, float] | None = (8.0, 4.0, 1.5),
+                 slide: tuple[float, float, float] | None = (3.0, 5.0, 0.4),
+                 balises: tuple[float, ...] = (100.0, 300.0), joints: tuple[float, ...] = (250.0, 450.0, 520.0),
+                 accelerometer: bool = True, accel_bias_ms2: float = 0.02, true_wheel_diameter_m: float | None = None,
+                 **odometer: Any) -> RunResult:
+    """Accelerate, run at ``v_max_kmh``, brake to a stand at ``length_m``, reading balises at ``balises`` and
+    correcting at the section joints ``joints`` (the front entering the next section).
+
+    ``slip = (start s, duration s, excess m/s)``: the wheel spins that much faster than the locomotive runs, while
+    accelerating; ``slide = (start s after braking begins, duration s, wheel/true speed ratio)``: the wheel locks
+    partly while braking; ``None`` for a clean run. The accelerometer reads the true acceleration plus a bias.
+    Odometer keyword arguments (``a_max``, ``window_s`` ...) go to both odometers.
+    """
+    v_max = v_max_kmh / 3.6
+    d_acc = v_max * v_max / (2 * accel_ms2)
+    d_dec = v_max * v_max / (2 * decel_ms2)
+    if d_acc + d_dec > length_m:
+        raise ValueError("the run is too short to reach v_max")
+    t_acc = v_max / accel_ms2
+    t_brake = t_acc + (length_m - d_acc - d_dec) / v_max
+    t_end = t_brake + v_max / decel_ms2
+
+    def motion(t: float) -> tuple[float, float, float]:
+        """(position, speed, acceleration) of the locomotive at time t."""
+        if t < t_acc:
+            return accel_ms2 * t * t / 2, accel_ms2 * t, accel_ms2
+        if t < t_brake:
+            return d_acc + v_max * (t - t_acc), v_max, 0.0
+        u = min(t, t_end) - t_brake
+        return length_m - d_dec + v_max * u - decel_ms2 * u * u / 2, v_max - decel_ms2 * u, -decel_ms2
+
+    d = float(odometer.pop("wheel_diameter_m", 1.05))
+    real_d = true_wheel_diameter_m if true_wheel_diameter_m is not None else d
+    comp = Odometer(d, **odometer)
+    naive = Odometer(d, compensate=False, **odometer)
+    out = RunResult(stop_m=length_m, last_section_m=max((j for j in joints if j < length_m), default=0.0))
+    marks = sorted([(b, "balise") for b in balises] + [(j, "section") for j in joints])
+    k = 0
+    t = x = 0.0
+    while t < t_end - 1e-9:
+        h = min(dt, t_end - t)
+        x_new, v, _ = motion(t + h)
+        wheel = (x_new - x) / h  # the tacho counts the distance run in the interval
+        a = motion(t + h / 2)[2]
+        t, x = t + h, x_new
+        if slip is not None:
+            wheel += slip[2] * _ramp(t, slip[0], slip[1], 0.5)
+        if slide is not None:
+            wheel *= 1.0 - (1.0 - slide[2]) * _ramp(t, t_brake + slide[0], slide[1], 0.3)
+        wheel *= real_d / d  # a worn wheel turns faster than the odometer thinks
+        acc = a + accel_bias_ms2 if accelerometer else None
+        for o in (comp, naive):
+            o.update(h, wheel, acc)
+        while k < len(marks) and marks[k][0] <= x:
+            since = (x - marks[k][0]) / v if v > 0 else 0.0  # the reader's time stamp: passed during this interval
+            for o in (comp, naive):
+                o.correct(marks[k][0], marks[k][1], since_s=since)
+            k += 1
+        out.t.append(t)
+        out.true_m.append(x)
+        out.measured_m.append(comp.position_m)
+        out.naive_m.append(naive.position_m)
+        out.true_ms.append(v)
+        out.wheel_ms.append(wheel)
+        out.slipping.append(comp.slipping)
+        out.sliding.append(comp.sliding)
+    out.corrections = comp.corrections
+    out.naive_corrections = naive.corrections
+    return out
