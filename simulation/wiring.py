@@ -19,11 +19,14 @@ class Wiring:
         self.field = field
         self.commands = FieldCommands()
         self.signal_lamps = {s.id: {lamp.value for lamp in s.lamps} for s in station.model.signals}
+        self._lit = False  # the first commands light every signal's lamps (the aspects set before any cycle)
 
     def commands_from(self, out: Outputs) -> FieldCommands:
         cmd = self.commands
         cmd.drives = out.turnouts
-        for sig in out.changed_signals:
+        changed = out.changed_signals if self._lit else set(out.signals)
+        self._lit = True
+        for sig in changed:
             aspect = out.signals.get(sig, "")
             cmd.lamps[sig] = set(self.rules.lamps.get(aspect, [])) & self.signal_lamps[sig]
             if aspect == "USU":
