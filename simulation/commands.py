@@ -44,7 +44,7 @@ USAGE = {
     "occupy": "occupy SECTION",
     "vacate": "vacate SECTION",
     "run": "run DURATION",
-    "expect": "expect signal|route|turnout|section|refused|accepted|alarm|no-alarm|block-line|code ...",
+    "expect": "expect signal|route|turnout|section|refused|accepted|alarm|no-alarm|block-line|code|odometry ...",
 }
 
 
@@ -256,6 +256,17 @@ def _expect(sim: Simulation, args: list[str]) -> Result:
         if bl is None:
             return Result.refuse(f"there is no 64D block line '{rest[0]}'")
         return Result(bl.state.value == rest[1], f"block line {rest[0]} is {bl.state.value}")
+    if what == "odometry" and len(rest) == 3 and rest[1] == "within":
+        tr = sim.fleet.trains.get(rest[0])
+        if tr is None:
+            return Result.refuse(f"there is no train '{rest[0]}'")
+        try:
+            bound = float(rest[2].removesuffix("m"))
+        except ValueError:
+            return Result.refuse("expect odometry NAME within METRES")
+        err = tr.odometer.error_m(tr.travelled_m)
+        return Result(abs(err) <= bound, f"odometry of {rest[0]} is {err:+.2f} m off" +
+                      ("" if abs(err) <= bound else f", expected within {bound:g} m"))
     if what == "code" and len(rest) == 2:
         s, want = rest
         shown = il.out.cab_codes.get(s) or "none"

@@ -25,6 +25,7 @@ USAGE = {
     "auto": "auto NAME [plan=ROUTE,ROUTE,...] [onboard=on|off] [centre=on|off] [loco=ok|fault] "
             "[perception=ok|fault]",
     "estop": "estop NAME SOURCE (team, cab, remote, system)",
+    "slip": "slip NAME RATIO DURATION (wheel speed off by RATIO: 0.3 slips 30 % fast, -0.3 slides)",
     "estop-release": "estop-release NAME SOURCE [by=SOURCE]",
     "reverse": "reverse NAME (change the direction of travel; the train must stand)",
 }
@@ -172,6 +173,26 @@ def _auto(sim: Simulation, args: list[str]) -> Result:
     return sim.attach_auto(sim.fleet.trains[name], plan, flags)
 
 
+def _slip(sim: Simulation, args: list[str]) -> Result:
+    from ..timeparse import parse_duration
+
+    name, bad = _named(sim, args, "slip", 3)
+    if bad:
+        return bad
+    try:
+        ratio = float(args[1])
+        seconds = parse_duration(args[2])
+    except ValueError as exc:
+        return Result.refuse(f"slip: {exc}" if "duration" in str(exc) else "RATIO must be a number, e.g. 0.3 or -0.3")
+    if not -0.9 <= ratio <= 2.0:
+        return Result.refuse("RATIO must lie between -0.9 (a locked wheel slides) and 2 (a wheel spinning 3x)")
+    tr = sim.fleet.trains[name]
+    tr.slip_ratio, tr.slip_until = ratio, sim.fleet.t + seconds
+    tr.extra["slip_from"] = sim.fleet.t
+    what = "slipping" if ratio > 0 else "sliding"
+    return Result.accept(f"train {name}: wheels {what} {abs(ratio) * 100:g} % for {seconds:g} s")
+
+
 def _estop(sim: Simulation, args: list[str]) -> Result:
     name, bad = _named(sim, args, "estop", 2)
     if bad:
@@ -213,4 +234,5 @@ def _reverse(sim: Simulation, args: list[str]) -> Result:
 
 
 TRAIN_COMMANDS: dict[str, Handler] = {"train": _train, "drive": _drive, "stop": _stop, "auto": _auto,
-                                      "reverse": _reverse, "estop": _estop, "estop-release": _estop_release}
+                                      "reverse": _reverse, "estop": _estop, "estop-release": _estop_release,
+                                      "slip": _slip}

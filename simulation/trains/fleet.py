@@ -19,8 +19,10 @@ from .consist import Consist
 from .drivers import driving_rules, look_ahead, stopping_speed, target_speed
 from .engine import KinematicEngine, MotionEngine
 from .movement import OUTSIDE, Notify, Position, Track
+from .odometry import Odometer
 
 MODES = ("manual", "signal", "auto")
+SLIP_RAMP_S = 1.0
 
 
 @dataclass
@@ -53,6 +55,10 @@ class Train:
     controller: object | None = None  # the automatic shunting controller, when in auto mode
     shunting: bool = False  # a shunting movement (heeds shunting signals) rather than a train movement
     estops: EmergencyStops = field(default_factory=EmergencyStops)  # emergency stops by source (seed 002)
+    odometer: Odometer = field(default_factory=Odometer)  # on-board speed and distance measurement (seed 001)
+    travelled_m: float = 0.0  # the true distance run since placed (what the odometer estimates)
+    slip_ratio: float = 0.0  # wheel speed / true speed - 1 while an injected slip (> 0) or slide (< 0) lasts
+    slip_until: float = 0.0
     extra: dict[str, object] = field(default_factory=dict)
 
     @property
@@ -122,8 +128,38 @@ class Fleet:
         for name, (speed, ds) in motion.items():
             moving = self.trains.get(name)
             if moving is not None:
+                accel = (speed - moving.speed_ms) / dt
                 moving.speed_ms = speed
+                self._odometry(moving, dt, ds, accel)
                 self._move(moving, ds)
+
+    def _odometry(self, tr: Train, dt: float, ds: float, accel: float) -> None:
+        """Feed the on-board odometer: the wheels turn at the train's speed, faster while slipping, slower while
+        sliding; it is corrected at balises / RFID tags and where the front crosses into the next section."""
+        slip = 0.0
+        if tr.slip_ratio and self.t < tr.slip_until + SLIP_RAMP_S:
+            # a slip or slide builds up and dies away over about a second rather than jumping
+            since = self.t - float(tr.extra.get("slip_from", self.t))
+            slip = tr.slip_ratio * max(0.0, min(1.0, since / SLIP_RAMP_S, (tr.slip_until + SLIP_RAMP_S - self.t)
+                                                 / SLIP_RAMP_S))
+        before = tr.travelled_m
+        tr.travelled_m += ds
+        tr.odometer.update(dt, (ds / dt) * (1.0 + slip), accel_ms2=accel)
+        if ds <= 0:
+            return
+        v = ds / dt
+        for dist, node, _ in self.track.ahead(tr.pos, ds):
+            if dist > ds:
+                break
+            if node in self.station.joints:  # passed (ds - dist) / v seconds before the end of this step
+                tr.odometer.section_transition(before + dist, since_s=(ds - dist) / v)
+        for start, move in self.track.moves_ahead(tr.pos, ds):
+            for mk in self.station.model.markers:
+                if mk.track != move[0] or mk.kind.value not in ("balise", "rfid"):
+                    continue
+                s = self.track.s_of_x(move, mk.at)
+                if s is not None and 0.0 <= start + s < ds:
+                    tr.odometer.correct(before + start + s, mk.kind.value, since_s=(ds - start - s) / v)
 
     def _move(self, tr: Train, ds: float) -> None:
         c = tr.consist
