@@ -172,6 +172,9 @@ def build_parser() -> argparse.ArgumentParser:
     from .zpwcli import register as register_zpw
 
     register_zpw(add)
+    from .verify.cli import register as register_verify
+
+    register_verify(add)
     return p
 
 

@@ -1,0 +1,113 @@
+"""Pairs of routes: conflicting routes (敌对进路) can never be locked together, compatible ones can.
+
+Each route in turn is set on a fresh simulation. Every route that conflicts with it must then be refused, both while
+it is still setting and once its signal is open (so each conflicting pair is tried both ways round; a refused
+command changes nothing, so they can all be tried on the one simulation). Then every compatible route after it in
+the table is set as well: both signals must be open together (with their liaison given); it is cancelled again
+before the next. A failure is replayed on a fresh simulation, so its script shows just the two routes.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from functools import partial
+
+from interlocking.table import Route
+
+from .probe import Context, Probe, open_route, prepare, route_line
+
+SETTLE_S = 30.0
+
+
+def released(p: Probe, r: Route) -> bool:
+    return p.state(r) == "released"
+
+
+def conflicting(a: Route, b: Route) -> bool:
+    return b.id in a.conflicts or a.id in b.conflicts or a.signal == b.signal
+
+
+class PairTest:
+    def __init__(self, ctx: Context) -> None:
+        self.ctx = ctx
+        self.tested = 0
+        self.conflicting = 0
+        self.compatible = 0
+
+    def run(self, routes: Iterable[Route], focus: set[str] | None = None) -> None:
+        order = list(routes)
+        for i, a in enumerate(order):
+            rivals = [b for b in order if b is not a and conflicting(a, b) and (not focus or {a.id, b.id} & focus)]
+            later = [b for b in order[i + 1:] if not conflicting(a, b) and (not focus or {a.id, b.id} & focus)]
+            for b in order[i + 1:]:
+                if focus and a.id not in focus and b.id not in focus:
+                    continue
+                self.tested += 1
+                if conflicting(a, b):
+                    self.conflicting += 1
+                else:
+                    self.compatible += 1
+                if (b.id in a.conflicts) != (a.id in b.conflicts):
+                    self.ctx.record(False, "conflict-symmetry", f"{a.id} + {b.id}",
+                                    "the table lists the conflict on one route only")
+            if rivals or later:
+                self.first(a, rivals, later)
+
+    def why(self, a: Route, b: Route) -> str:
+        return a.conflicts.get(b.id) or b.conflicts.get(a.id) or f"both start at {a.signal}"
+
+    def first(self, a: Route, rivals: list[Route], later: list[Route]) -> None:
+        p = Probe(self.ctx)
+        prepare(p, a)
+        if not self.ctx.record(p.do(route_line(a)).ok, "pair-setup", a.id,
+                               f"'{route_line(a)}' was refused on a fresh station", p):
+            return
+        for b in rivals:
+            result = p.do(route_line(b))
+            if not result.ok:
+                self.ctx.record(True, "conflict", f"{a.id} + {b.id}", "")
+                continue
+            self.replay_conflict(a, b, "setting")
+            return
+        if not p.until(lambda: p.state(a) == "open", SETTLE_S):
+            self.ctx.record(False, "pair-setup", a.id, f"signal {a.signal} did not open: {p.blocker(a)}", p)
+            return
+        for b in rivals:
+            result = p.do(route_line(b))
+            if not result.ok:
+                self.ctx.record(True, "conflict", f"{a.id} + {b.id}", "")
+                continue
+            self.replay_conflict(a, b, "open")
+            return
+        for b in later:
+            ok = open_route(p, b, timeout_s=SETTLE_S) and p.state(a) == "open"
+            if ok:
+                self.ctx.record(True, "compatible", f"{a.id} + {b.id}", "")
+            else:
+                self.replay_together(a, b)
+            result = p.do(f"cancel {b.signal}")
+            if not result.ok or not p.until(partial(released, p, b), 5.0) or p.state(a) != "open":
+                p = Probe(self.ctx)  # could not get back to 'a alone': start again for the rest
+                if not open_route(p, a, timeout_s=SETTLE_S):
+                    return
+
+    def replay_conflict(self, a: Route, b: Route, when: str) -> None:
+        """``b`` was accepted with ``a`` set: record the failure with a script of just the two routes."""
+        p = Probe(self.ctx)
+        prepare(p, a)
+        p.do(route_line(a))
+        if when == "open":
+            p.until(lambda: p.state(a) == "open", SETTLE_S)
+        result = p.do(route_line(b))
+        p.run(1.0)
+        self.ctx.record(False, "conflict", f"{a.id} + {b.id}", f"{b.id} conflicts with {a.id} ({self.why(a, b)}) "
+                        f"but was accepted with {a.id} {when}" + ("" if result.ok else " (only after the routes "
+                                                                  "tried before it)"), p)
+
+    def replay_together(self, a: Route, b: Route) -> None:
+        p = Probe(self.ctx)
+        ok = open_route(p, a, b, timeout_s=SETTLE_S)
+        detail = f"{p.blocker(a)}; {p.blocker(b)}"
+        self.ctx.record(False, "compatible", f"{a.id} + {b.id}", f"{a.id} and {b.id} do not conflict but could not "
+                        f"both be set and open: {detail}" + (" (only after the routes tried before it)" if ok else ""),
+                        p)
