@@ -117,10 +117,17 @@ def cmd_run(args: argparse.Namespace) -> int:
         except ValueError as exc:
             print(f"--until: {exc}", file=sys.stderr)
             return 2
+    from .trains.sumo import SumoEngineError
+    from .trains.sumo_export import SumoExportError, SumoUnavailable
+
     try:
-        status, _ = run_scenario(sc, until)
+        status, sim = run_scenario(sc, until, engine=args.engine)
     except StationError as exc:
         return _print_errors(exc)
+    except (SumoUnavailable, SumoExportError, SumoEngineError) as exc:  # the SUMO engine could not start
+        print(f"liansuo run --engine {args.engine}: {exc}", file=sys.stderr)
+        return 2
+    sim.close()
     return status
 
 
@@ -169,6 +176,9 @@ def build_parser() -> argparse.ArgumentParser:
     sp = add("run", cmd_run, "run a scenario headless and print the event log")
     sp.add_argument("scenario", help="scenario YAML file")
     sp.add_argument("--until", metavar="DURATION", help="keep running to this simulated time (e.g. 10min)")
+    sp.add_argument("--engine", choices=("kinematic", "sumo"), default="kinematic",
+                    help="what moves the trains: the built-in kinematic model (default) or Eclipse SUMO "
+                         "(pip install 'liansuo[sumo]'; see docs/sumo.md)")
     from .zpwcli import register as register_zpw
 
     register_zpw(add)

@@ -75,13 +75,15 @@ def parse_scenario(path: Path) -> Scenario:
     return Scenario(str(path), str(data["station"]), str(data.get("description", "")), steps, until)
 
 
-def run_scenario(sc: Scenario, until_s: float | None = None, out: list[str] | None = None) -> tuple[int, Simulation]:
-    """Run the scenario; returns (exit status, the simulation). Lines of the event log go to ``out`` (or stdout)."""
+def run_scenario(sc: Scenario, until_s: float | None = None, out: list[str] | None = None,
+                 engine: str = "kinematic") -> tuple[int, Simulation]:
+    """Run the scenario; returns (exit status, the simulation). Lines of the event log go to ``out`` (or stdout).
+    ``engine``: the train engine, "kinematic" or "sumo" (see :class:`Simulation`)."""
     try:
         station = load(sc.station)
     except StationError:
         station = load(Path(sc.file).parent / sc.station)
-    sim = Simulation(station)
+    sim = Simulation(station, engine=engine)
     seen = [0, 0]  # events already printed from the interlocking and from the world
 
     def emit(text: str) -> None:

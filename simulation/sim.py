@@ -21,6 +21,8 @@ from stations.loader import load
 from stations.station import Station
 
 from .neighbour import Neighbours
+from .trains.engine import MotionEngine
+from .trains.engines import attach_engine, make_engine
 from .trains.fleet import Fleet, Train
 from .wiring import Wiring
 
@@ -40,7 +42,9 @@ class TrainView:
 
 class Simulation:
     def __init__(self, station: str | Path | Station, *, cycle_s: float = 0.25, rules: str | RuleSet = "china",
-                 table: InterlockingTable | None = None) -> None:
+                 table: InterlockingTable | None = None, engine: str | MotionEngine = "kinematic") -> None:
+        """``engine``: what moves the trains, "kinematic" (built in, the default) or "sumo" (Eclipse SUMO, the
+        ``sumo`` extra; see docs/sumo.md), or a :class:`~simulation.trains.engine.MotionEngine`."""
         self.station = station if isinstance(station, Station) else load(station)
         self.rules = load_rules(rules) if isinstance(rules, str) else rules
         self.table = table or build_table(self.station)
@@ -54,8 +58,10 @@ class Simulation:
         self.parked: dict[str, list[Axle]] = {}  # named sets of wheelsets placed by hand (``axles`` command)
         self.events: deque[Event] = deque(maxlen=20_000)  # the world's own events: trains, faults
         self.alarms: dict[str, str] = {}  # the world's alarms (derailment, squeeze by a train)
+        motion = make_engine(engine, self.station, cycle_s)
         self.fleet = Fleet(self.station, self.field, lambda: self.interlocking.out.signals, self.log,
-                           self._auto_limit)
+                           self._auto_limit, engine=motion)
+        attach_engine(motion, self.fleet)
         self.wiring.publish(self.interlocking.board, everything=True)
         self.interlocking.cycle(self.t)
 
@@ -108,6 +114,10 @@ class Simulation:
         from .trains.ato import platform_doors
 
         platform_doors(self)
+
+    def close(self) -> None:
+        """Release what the train engine holds (the SUMO worker process); the kinematic engine holds nothing."""
+        self.fleet.engine.close()
 
     def run(self, seconds: float) -> None:
         for _ in range(max(0, round(seconds / self.cycle_s))):
