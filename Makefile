@@ -6,11 +6,14 @@ STAMP := $(VENV)/.installed
 
 .PHONY: run test lint clean
 
-# Reinstall only when pyproject.toml changed since the last install.
+# Reinstall only when pyproject.toml changed since the last install. The sumo extra (libsumo, eclipse-sumo, about
+# 230 MB) is installed too where it can be; where it cannot, the SUMO engine's tests skip and say why.
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
 	$(BIN)/python -m pip install --quiet -e '.[test]'
+	$(BIN)/python -m pip install --quiet -e '.[sumo]' > $(VENV)/sumo-install.log 2>&1 \
+		|| echo "notice: the sumo extra (libsumo, eclipse-sumo) could not be installed, the SUMO engine tests will skip (see $(VENV)/sumo-install.log)"
 	touch $(STAMP)
 
 run: $(STAMP)
