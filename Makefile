@@ -17,7 +17,7 @@ $(STAMP): pyproject.toml
 	touch $(STAMP)
 
 run: $(STAMP)
-	$(BIN)/liansuo run-default
+	$(BIN)/liansuo tui
 
 test: $(STAMP)
 	$(BIN)/python -m pytest

@@ -7,7 +7,7 @@ import json
 import sys
 from collections.abc import Callable, Sequence
 
-from stations.library import DEFAULT_STATION, bundled, describe
+from stations.library import bundled, describe
 from stations.loader import load
 from stations.schema import StationFile
 from stations.source import StationError
@@ -131,16 +131,6 @@ def cmd_run(args: argparse.Namespace) -> int:
     return status
 
 
-def cmd_run_default(args: argparse.Namespace) -> int:
-    """Headless stand-in for the console until it exists: load the default station and print its state."""
-    try:
-        station = load(DEFAULT_STATION)
-    except StationError as exc:
-        return _print_errors(exc)
-    print(summary_text(station))
-    return 0
-
-
 def cmd_bench(args: argparse.Namespace) -> int:
     from .bench import main as bench_main
 
@@ -169,7 +159,6 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("-k", metavar="TEXT", help="run only tests whose name contains TEXT")
     sp.add_argument("-v", "--verbose", action="store_true", help="print every step of failing tests")
     sp.add_argument("--junit-xml", metavar="FILE", help="also write a JUnit XML report")
-    add("run-default", cmd_run_default, "load the default station headless and print its state")
     sp = add("bench", cmd_bench, "benchmark table building and the interlocking cycle (hub and jiaopei)")
     sp.add_argument("--quick", action="store_true", help="fewer cycles (under a minute)")
     sp.add_argument("--format", choices=("json", "text"), default="json")
@@ -185,7 +174,22 @@ def build_parser() -> argparse.ArgumentParser:
     from .verify.cli import register as register_verify
 
     register_verify(add)
+    _register_plugins(add)
     return p
+
+
+def _register_plugins(add: Callable[..., argparse.ArgumentParser]) -> None:
+    """Subcommands of the layers above (the console: ``liansuo tui``, ``liansuo replay``), found through the
+    ``liansuo.commands`` entry-point group so this module never imports them."""
+    from importlib.metadata import entry_points
+
+    for ep in entry_points(group="liansuo.commands"):
+        try:
+            register = ep.load()
+        except ImportError as exc:  # a broken plugin must not take the rest of the command line down
+            print(f"liansuo: subcommand '{ep.name}' unavailable: {exc}", file=sys.stderr)
+            continue
+        register(add)
 
 
 def main(argv: Sequence[str] | None = None) -> int:

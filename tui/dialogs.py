@@ -1,0 +1,133 @@
+"""Modal dialogs: the confirmation a real console asks for, element menus, the instructor password, help."""
+
+from __future__ import annotations
+
+from typing import ClassVar
+
+from textual.app import ComposeResult
+from textual.binding import Binding, BindingType
+from textual.containers import Grid, Vertical
+from textual.screen import ModalScreen
+from textual.widgets import Button, Input, Label, Static
+
+from .operate import MENUS, MODES
+
+DIALOG_CSS = """
+{name} {{ align: center middle; background: rgba(0, 0, 0, 0.55); }}
+{name} > Vertical {{ width: 60; max-width: 100%; height: auto; padding: 0 1; border: round #ffd700;
+    background: #1b1f24; }}
+{name} Label {{ width: 100%; margin: 0 0 1 0; }}
+{name} Grid {{ grid-size: 2; grid-columns: 1fr 1fr; grid-gutter: 0 1; height: auto; width: 100%; }}
+{name} Button {{ width: 100%; margin: 0; }}
+"""
+
+
+class ConfirmScreen(ModalScreen[bool]):
+    """总人解, 区故解, 引导 and 引导总锁 are confirmed before they are sent (y / Enter yes, n / Esc no)."""
+
+    DEFAULT_CSS = DIALOG_CSS.format(name="ConfirmScreen")
+    BINDINGS: ClassVar[list[BindingType]] = [
+        Binding("y", "answer(True)", "yes"),
+        Binding("n,escape", "answer(False)", "no"),
+    ]
+
+    def __init__(self, question: str) -> None:
+        super().__init__()
+        self.question = question
+
+    def compose(self) -> ComposeResult:
+        with Vertical():
+            yield Label(self.question)
+            with Grid():
+                yield Button("确认 Yes (y)", id="yes", variant="warning", compact=True)
+                yield Button("取消 No (n)", id="no", compact=True)
+
+    def on_mount(self) -> None:
+        self.query_one("#yes", Button).focus()
+
+    def on_button_pressed(self, event: Button.Pressed) -> None:
+        self.dismiss(event.button.id == "yes")
+
+    def action_answer(self, yes: bool) -> None:
+        self.dismiss(yes)
+
+
+class MenuScreen(ModalScreen[str]):
+    """What can be done with a turnout, a signal or a section; returns the function's name ('' for none)."""
+
+    DEFAULT_CSS = DIALOG_CSS.format(name="MenuScreen")
+    BINDINGS: ClassVar[list[BindingType]] = [Binding("escape", "close", "close")]
+
+    def __init__(self, kind: str, element: str, title: str = "") -> None:
+        super().__init__()
+        self.kind = kind
+        self.element = element
+        self.title_text = title or f"{kind} {element}"
+
+    def compose(self) -> ComposeResult:
+        with Vertical():
+            yield Label(self.title_text)
+            with Grid():
+                for name in MENUS.get(self.kind, ()):
+                    m = MODES[name]
+                    yield Button(f"{m.zh} {m.en}", id=f"m-{name}", compact=True)
+                yield Button("关闭 close", id="m-", compact=True)
+
+    def on_mount(self) -> None:
+        self.query(Button).first().focus()
+
+    def on_button_pressed(self, event: Button.Pressed) -> None:
+        self.dismiss((event.button.id or "m-")[2:])
+
+    def action_close(self) -> None:
+        self.dismiss("")
+
+
+class PasswordScreen(ModalScreen[str]):
+    DEFAULT_CSS = DIALOG_CSS.format(name="PasswordScreen") + "PasswordScreen Input { width: 34; }"
+    BINDINGS: ClassVar[list[BindingType]] = [Binding("escape", "close", "close")]
+
+    def compose(self) -> ComposeResult:
+        with Vertical():
+            yield Label("教员 Instructor mode: password")
+            yield Input(password=True, id="password")
+
+    def on_mount(self) -> None:
+        self.query_one(Input).focus()
+
+    def on_input_submitted(self, event: Input.Submitted) -> None:
+        self.dismiss(event.value)
+
+    def action_close(self) -> None:
+        self.dismiss("")
+
+
+HELP = """\
+操作表示机 Operator console — keys and mouse
+
+Set a route: click the start button (L train / D shunting, next to the signal), optional
+variant buttons, then the end button. Esc drops the selection.
+Function buttons (bottom bar, or their key), then click the signal / turnout / section:
+  c 总取消 cancel    r 总人解 manual release   f 区故解 section fault release
+  g 引导 guide       G 引导总锁 guide total lock (toggles)   o 重开 reopen
+  n 总定位 normal    v 总反位 reverse   l 单锁 lock   u 单解 unlock   b 单封 block   B 解封 unblock
+Click a turnout number, a signal or a section band for its menu.
+
+Keyboard: arrows move the cursor between elements, Enter presses; shift+arrows or the mouse wheel pan;
++ / - zoom, 0 fit.   : command bar (Tab completes, Up/Down history, Esc back)
+Clock: space pause/run, . one cycle, > faster, < slower.   a acknowledge alarms
+F2 instructor panel (faults, trains, exercises).   ctrl+q quit.
+Replay: [ ] seek 10 s, { } seek 60 s, home / end.
+"""
+
+
+class HelpScreen(ModalScreen[None]):
+    DEFAULT_CSS = DIALOG_CSS.format(name="HelpScreen") + "HelpScreen > Vertical { width: 100; }"
+    BINDINGS: ClassVar[list[BindingType]] = [Binding("escape,q,question_mark,f1", "close", "close")]
+
+    def compose(self) -> ComposeResult:
+        with Vertical():
+            yield Static(HELP)
+
+    def action_close(self) -> None:
+        self.dismiss(None)
