@@ -12,7 +12,8 @@ from .io import Outputs
 from .rules import RuleSet
 from .state import RouteStage, RouteState
 
-_FOLLOW = {"H": "U", "A": "U", "": "U", "U": "LU", "UU": "U"}  # aspect ahead -> this signal; anything else -> L
+# aspect ahead -> this signal; anything else -> L. A guide aspect (HB) ahead shows its red lamp: prepare to stop.
+_FOLLOW = {"H": "U", "A": "U", "": "U", "HB": "U", "U": "LU", "UU": "U"}
 
 
 class AutoBlock:

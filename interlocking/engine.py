@@ -92,6 +92,9 @@ class Engine:
     def cycle(self, t: float) -> Outputs:
         self.now = t
         self.cycles += 1
+        # aspects set since the last cycle's chain update (by operator commands: cancel, reopen, guide) still have to
+        # reach the automatic block signals in rear
+        commanded = bool(self.out.changed_signals)
         self.out.changed_signals.clear()  # from here on: what this cycle changed
         self.out.changed_turnouts.clear()
         tracks, turnouts, signals, doors, pulses = self.board.take_changes()
@@ -120,7 +123,7 @@ class Engine:
             self._advance(rs)
         self._guide_only()
         self._overlaps()
-        if self.autoblock.signals and (tracks or self.out.changed_signals):
+        if self.autoblock.signals and (tracks or commanded or self.out.changed_signals):
             self.autoblock.update(self.out, self.clear, self._proven)
         if self.codes_dirty or self.out.changed_signals:
             self.codes_dirty = False
