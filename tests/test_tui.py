@@ -352,7 +352,7 @@ async def test_recording_and_replay_reproduce_the_session(tmp_path: Path) -> Non
         assert replay.replayer.mismatches == []
         await pilot.press("home")
         await pilot.pause()
-        assert replay.sim.t == 0 and replay.sim.route_state("X-XI") == "setting"  # sent at t = 0
+        assert replay.sim.t == 0 and replay.sim.route_state("X-XI") == "released"
         await pilot.press("right_square_bracket")
         await pilot.pause()
         assert replay.sim.t == pytest.approx(min(10.0, rec.duration))

@@ -93,6 +93,7 @@ class ConsoleApp(App[None]):
         self._debt = 0.0
         self._wall = time.monotonic()
         self._ticks = 0
+        self.warm_up = True
         self.instructor_panel: InstructorPanel | None = None  # mounted the first time instructor mode opens
         self.recorder: FileRecorder | None = None
         if record is not None:
@@ -128,6 +129,8 @@ class ConsoleApp(App[None]):
         self.message_line = self.query_one(MessageLine)
         self.command_bar = self.query_one(CommandBar)
         self.diagram.focus()
+        if self.warm_up and self.sim.t == 0:
+            self.advance(1)  # one cycle, so the field has lit the lamps the interlocking commanded at start
         self.say(f"{self.sim.station.display_name()}: click a signal's L or D button to start a route; ? for help")
         if self._exercise_arg is not None:
             self.load_exercise(str(self._exercise_arg))

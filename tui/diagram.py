@@ -98,14 +98,25 @@ class Diagram(ScrollView, can_focus=True):
             lay = self._build(lpr, self.zoom, 0)
         self.layout_ = lay
         self.virtual_size = Size(lay.width, lay.height)
-        if not self._centred and lay.width > w:
+        if not self._centred and self.size.width > 0:
             self._centred = True
-            self.scroll_to(x=self._station_centre(lay) - w // 2, animate=False, immediate=True)
+            self.call_after_refresh(self._centre)
         self.refresh()
 
+    def _centre(self) -> None:
+        """Start with the station tracks in the middle of the window (the open line may not fit)."""
+        lay = self.layout_
+        if lay is not None and lay.width > self.size.width:
+            x = self._station_centre(lay) - self.size.width // 2
+            self.scroll_to(x=max(0, x), animate=False, immediate=True)
+
     def _station_centre(self, lay: Layout) -> int:
-        xs = [x for sec in self.sim.station.sections if self.sim.station.is_station_track(sec)
-              for x, _ in lay.section_cells.get(sec, [])]
+        """Between the home signals (the station's two throats), else the middle of the station tracks."""
+        st = self.sim.station
+        xs = [lay.targets[r][0] for s in st.model.signals if s.kind.value == "home"
+              if (r := Ref("signal", s.id)) in lay.targets]
+        if len(xs) < 2:
+            xs = [x for sec in st.sections if st.is_station_track(sec) for x, _ in lay.section_cells.get(sec, [])]
         return (min(xs) + max(xs)) // 2 if xs else lay.width // 2
 
     def reset_station(self) -> None:

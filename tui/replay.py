@@ -38,6 +38,7 @@ class ReplayApp(ConsoleApp):
         self.replayer = Replayer(rec)
         self.rec = rec
         super().__init__(rec.station, paused=paused, speed=speed, sim=self.replayer.sim)
+        self.warm_up = False  # the recording has its own first cycle
 
     def on_mount(self) -> None:
         super().on_mount()
