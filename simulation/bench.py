@@ -15,6 +15,10 @@ For each station:
   teaching base's switch K), and sets the route again once it has released;
 * ``realtime_factor``: simulated seconds per wall second over the busy run, driver and route commands included.
 
+And on the hub, trains (``simulation.bench_trains``): ``realtime_factor_trains``, 10 signal-obeying trains running
+through the hub on the kinematic engine, and ``realtime_factor_trains_sumo``, the same on the SUMO engine, with their
+ratio (SUMO "not installed" where the extra is missing).
+
 And once, station-independent: ``zpw_configs_per_s``, ZPW-2000A section configurations (carrier x ballast x
 capacitor fault x shunt position) evaluated per second by the vectorised sweep of ``circuits.zpw2000a``.
 """
@@ -37,6 +41,7 @@ from interlocking.table import InterlockingTable, Route, build_table
 from stations.loader import load, load_text
 from stations.station import Station
 
+from .bench_trains import TARGET_TRAINS, run_trains, trains_text
 from .hubgen import generate_hub
 from .sim import Simulation
 
@@ -66,15 +71,17 @@ class Sizes:
     busy_routes: int = BUSY_ROUTES
     warmup_limit: int = 2400  # cycles allowed for the busy routes to be set and opened once
     zpw_repeats: int = 10  # vectorised ZPW-2000A sweeps timed
+    train_cycles: int = 4800  # trains moving on the hub, each engine (bench_trains.py); 0 skips it
+    train_slots: int = 10
 
     @staticmethod
     def quick() -> Sizes:
-        return Sizes(idle_cycles=1000, busy_cycles=2400, zpw_repeats=3)
+        return Sizes(idle_cycles=1000, busy_cycles=2400, zpw_repeats=3, train_cycles=1200)
 
     @staticmethod
     def tiny() -> Sizes:
         return Sizes(hub_turnouts=20, hub_tracks=8, idle_cycles=20, busy_cycles=120, small_factor=1,
-                     warmup_limit=400, zpw_repeats=1)
+                     warmup_limit=400, zpw_repeats=1, train_cycles=240, train_slots=2)
 
 
 def _peak_rss_mb() -> float:
@@ -375,9 +382,14 @@ def run_bench(sizes: Sizes | None = None, *, quick: bool = False, stations: tupl
                                    busy_cycles=sizes.busy_cycles * sizes.small_factor,
                                    routes_limit=sizes.busy_routes, warmup_limit=sizes.warmup_limit)
     zpw = measure_zpw(sizes.zpw_repeats)
+    trains = _trains(sizes) if "hub" in stations and sizes.train_cycles > 0 else None
     targets = _check_targets(results)
     targets.append({"station": "zpw", "figure": "zpw_configs_per_s", "target": f">= {ZPW_TARGET_CONFIGS_PER_S:g}",
                     "value": zpw["zpw_configs_per_s"], "met": zpw["zpw_configs_per_s"] >= ZPW_TARGET_CONFIGS_PER_S})
+    if trains is not None:
+        value = trains["realtime_factor_trains"]
+        targets.append({"station": trains["station"], "figure": "realtime_factor_trains",
+                        "target": f">= {TARGET_TRAINS:g}", "value": value, "met": value >= TARGET_TRAINS})
     return {
         "benchmark": "liansuo bench",
         "mode": "quick" if quick else ("custom" if sizes != Sizes() else "full"),
@@ -385,9 +397,17 @@ def run_bench(sizes: Sizes | None = None, *, quick: bool = False, stations: tupl
         "cycle_s": 0.25,
         "results": results,
         "zpw": zpw,
+        **({"trains": trains} if trains is not None else {}),
         "targets": targets,
         "total_s": round(time.perf_counter() - start, 2),
     }
+
+
+def _trains(sizes: Sizes) -> dict[str, Any]:
+    """Trains moving on the hub: the kinematic engine and SUMO side by side (bench_trains.py)."""
+    station = load_text(generate_hub(sizes.hub_turnouts, sizes.hub_tracks), f"<hub{sizes.hub_turnouts}>")
+    return run_trains(station, build_table(station), cycles=sizes.train_cycles, sumo_cycles=sizes.train_cycles,
+                      slots=sizes.train_slots)
 
 
 def all_finite(value: object) -> bool:
@@ -427,6 +447,8 @@ def as_text(report: dict[str, Any]) -> str:
         lines.append(f"{'zpw configs/s':26}{z['zpw_configs_per_s']:>14.0f}  ({z['configurations']} per sweep of "
                      f"{z['sweep_s'] * 1000:.1f} ms; evaluate {z['evaluate_us_one_shunt']:.0f} us, 64-axle train "
                      f"{z['evaluate_us_train64']:.0f} us)")
+    if report.get("trains"):
+        lines += trains_text(report["trains"])
     lines.append("targets:")
     for t in report["targets"]:
         lines.append(f"  {t['station']:10} {t['figure']:16} {t['target']:>8}  measured {t['value']:g}  "

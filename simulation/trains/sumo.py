@@ -28,7 +28,9 @@ from multiprocessing.connection import Connection
 from multiprocessing.process import BaseProcess
 from typing import TYPE_CHECKING, Any
 
+from circuits.machines import SwitchMachine
 from stations.station import Station
+from stations.topology import Move
 
 from .consist import Consist
 from .engine import KinematicEngine
@@ -38,8 +40,6 @@ from .sumo_worker import main as worker_main
 
 if TYPE_CHECKING:
     from .fleet import Fleet
-
-ROUTE_HORIZON_M = 100_000.0  # the way ahead runs to where the rails end: a buffer stop, a boundary, a moving turnout
 
 
 class SumoEngineError(RuntimeError):
@@ -118,7 +118,8 @@ class SumoEngine:
         self._add: list[tuple[str, float, float, float, float, float]] = []
         self._remove: list[str] = []
         self._force: dict[str, float] = {}
-        self._routes: dict[str, tuple[str, ...]] = {}
+        self._routes: dict[str, tuple[str, ...]] = {}  # the route last sent for each train
+        self._ways: dict[str, tuple[Move, tuple[str, ...], tuple[tuple[SwitchMachine, str | None], ...]]] = {}
         self._exit: dict[str, str] = {}  # train -> the exit edge its front took last
         self._lights: dict[str, str] = {}
         self._aspects: dict[str, str] = {}
@@ -181,6 +182,7 @@ class SumoEngine:
         del self.consists[train]
         self.speeds.pop(train, None)
         self._routes.pop(train, None)
+        self._ways.pop(train, None)
         self._exit.pop(train, None)
         self._force.pop(train, None)
         self._add = [a for a in self._add if a[0] != train]
@@ -266,22 +268,49 @@ class SumoEngine:
         in no end position, or out through a boundary onto its exit edge), and the front's distance into the
         first. The rear is left to our model: SUMO only needs where the front goes."""
         assert self._fleet is not None
-        track = self._fleet.track
         net = self.network
         front = pos.moves[-1]
         if front[0] == OUTSIDE:  # leaving: the front is out on the exit edge past the boundary
             inside = [m for m in pos.moves if m[0] != OUTSIDE]
-            exit_edge = (net.exits.get(track.topo.far_node(inside[-1])) if inside else None) or self._exit.get(name)
+            far = self._fleet.track.topo.far_node(inside[-1]) if inside else None
+            exit_edge = (net.exits.get(far) if far else None) or self._exit.get(name)
             if exit_edge is None:
                 raise SumoEngineError(f"train {name} left the station where the network has no exit edge")
             self._exit[name] = exit_edge
             return (exit_edge,), pos.front_s
-        ahead = [m for _, m in track.moves_ahead(pos, ROUTE_HORIZON_M)]
-        edges = [net.edges[m] for m in ahead]
-        far = track.topo.far_node(ahead[-1])
-        if far in net.exits and not track.topo.next_moves(ahead[-1]):
-            edges.append(net.exits[far])
-        return tuple(edges), pos.front_s
+        cached = self._ways.get(name)
+        if cached is not None and cached[0] == front and all(m.rails == rails for m, rails in cached[2]):
+            return cached[1], pos.front_s
+        edges, facing = self._way(front)
+        self._ways[name] = (front, edges, facing)
+        return edges, pos.front_s
+
+    def _way(self, front: Move) -> tuple[tuple[str, ...], tuple[tuple[SwitchMachine, str | None], ...]]:
+        """The edges from ``front`` on as the rails lie (as :meth:`Track.moves_ahead` follows them), and the facing
+        turnouts it passes with the position each lies in: the way stays the same while they do."""
+        assert self._fleet is not None
+        topo = self._fleet.track.topo
+        machines = self._fleet.field.machines
+        net = self.network
+        edges = [net.edges[front]]
+        facing: list[tuple[SwitchMachine, str | None]] = []
+        move = front
+        for _ in range(len(net.edges)):
+            options = topo.next_moves(move)
+            if not options:
+                far = topo.far_node(move)
+                if far in net.exits:
+                    edges.append(net.exits[far])
+                break
+            if len(options) > 1:
+                m = machines[str(options[0][1]["turnout"])]
+                facing.append((m, m.rails))
+                options = [(n, data) for n, data in options if data["position"] == m.rails]
+                if not options:
+                    break  # a turnout in no end position: the way ends here (a train reaching it derails)
+            move = options[0][0]
+            edges.append(net.edges[move])
+        return tuple(edges), tuple(facing)
 
     def _light_changes(self, fleet: Fleet) -> dict[str, str]:
         """The traffic lights whose state changed since the last cycle, mirroring our aspects."""
