@@ -63,6 +63,13 @@ class ReplayApp(ConsoleApp):
                 log.add(f"{float(r['t']):9.2f} {'refused':8} {r.get('msg', '')}", "#ff8080")
 
     def seek(self, t: float) -> None:
+        try:
+            self._seek(t)
+        except Exception as exc:  # no traceback on the screen
+            self.paused = True
+            self.say(f"replay stopped: {type(exc).__name__}: {exc}", False)
+
+    def _seek(self, t: float) -> None:
         t = max(0.0, min(t, self.rec.duration))
         old = self.sim
         before = len(self.replayer.played)
