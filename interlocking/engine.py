@@ -257,15 +257,16 @@ class Engine:
             return False
         return not (r.approach and all(self.clear(s) for s in r.approach))
 
-    def open_blocker(self, rs: RouteState, *, guide: bool = False) -> str:
-        """Why the signal of ``rs`` may not open (or stay open); '' when every condition holds."""
+    def open_blocker(self, rs: RouteState, *, guide: bool = False, sections: bool = True) -> str:
+        """Why the signal of ``rs`` may not open (or stay open); '' when every condition holds. ``sections=False``
+        leaves out the track sections (a shunting consist passing its open signal occupies them)."""
         r = rs.route
         for t in r.all_turnouts:
             ind = self.board.indication(t.id)
             if ind != t.position.value:
                 what = "has no indication" if ind is None else f"is {ind}"
                 return f"turnout {t.id} {what}, the route needs it {t.position.value}"
-        if not guide:
+        if not guide and sections:
             for s in r.all_sections:
                 if not self.clear(s):
                     return f"section {s} is occupied"
@@ -374,7 +375,11 @@ class Engine:
         if not self.clear(r.sections[0]):
             rs.entered = True
             if r.kind == "shunt" and any(not self.clear(s) for s in r.approach):
-                return  # a shunting signal stays open until the whole consist is past it
+                # a shunting signal stays open until the whole consist is past it; everything else is still checked
+                blocker = self.open_blocker(rs, sections=False)
+                if blocker:
+                    self.close_signal(rs, blocker, abnormal=True)
+                return
             self.close_signal(rs, f"train entered {r.sections[0]}", abnormal=False)
             rs.stage = RouteStage.in_use
             self.codes_dirty = True
