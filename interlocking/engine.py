@@ -259,15 +259,16 @@ class Engine:
 
     def open_blocker(self, rs: RouteState, *, guide: bool = False, sections: bool = True) -> str:
         """Why the signal of ``rs`` may not open (or stay open); '' when every condition holds. ``sections=False``
-        leaves out the track sections (a shunting consist passing its open signal occupies them)."""
+        leaves out the route's own sections (a shunting consist passing its open signal occupies them), not its
+        fouling and overlap sections."""
         r = rs.route
         for t in r.all_turnouts:
             ind = self.board.indication(t.id)
             if ind != t.position.value:
                 what = "has no indication" if ind is None else f"is {ind}"
                 return f"turnout {t.id} {what}, the route needs it {t.position.value}"
-        if not guide and sections:
-            for s in r.all_sections:
+        if not guide:
+            for s in r.all_sections if sections else r.all_sections[len(r.sections):]:
                 if not self.clear(s):
                     return f"section {s} is occupied"
         blocker = self._liaison_blocker(r)
