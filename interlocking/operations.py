@@ -322,22 +322,22 @@ class Interlocking(Engine):
         return Result.accept(f"turnout {name} moving to {position}")
 
     def single_lock(self, name: str, on: bool) -> Result:
-        ids = self._turnout_ids(name)
-        if ids is None:
-            return Result.refuse(f"there is no turnout '{name}' at {self.station.id}")
-        for t in ids:
-            self.turnouts[t].single_locked = on
-        self.event("turnout", f"turnout {name} single-{'locked' if on else 'unlocked'}")
-        return Result.accept(f"turnout {name} {'single-locked (单锁)' if on else 'unlocked (单解)'}")
+        """单锁 / 单解: the turnout (and its crossover partner) may not be moved."""
+        return self._turnout_flag(name, "single_locked", on, ("single-locked (单锁)", "unlocked (单解)"))
 
     def single_block(self, name: str, on: bool) -> Result:
+        """单封 / 解封: no route through the turnout; individual operation stays allowed."""
+        return self._turnout_flag(name, "single_blocked", on, ("single-blocked (单封)", "unblocked (解封)"))
+
+    def _turnout_flag(self, name: str, flag: str, on: bool, words: tuple[str, str]) -> Result:
         ids = self._turnout_ids(name)
         if ids is None:
             return Result.refuse(f"there is no turnout '{name}' at {self.station.id}")
         for t in ids:
-            self.turnouts[t].single_blocked = on
-        self.event("turnout", f"turnout {name} {'blocked' if on else 'unblocked'}")
-        return Result.accept(f"turnout {name} {'single-blocked (单封)' if on else 'unblocked (解封)'}")
+            setattr(self.turnouts[t], flag, on)
+        word = words[0] if on else words[1]
+        self.event("turnout", f"turnout {name} {word}")
+        return Result.accept(f"turnout {name} {word}")
 
     # ---- 64D block and platform doors ------------------------------------------------------------------------
     def block_line(self, link: str, action: str) -> Result:
