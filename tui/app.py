@@ -94,6 +94,7 @@ class ConsoleApp(App[None]):
         self._wall = time.monotonic()
         self._ticks = 0
         self.warm_up = True
+        self._status = Text()
         self.instructor_panel: InstructorPanel | None = None  # mounted the first time instructor mode opens
         self.recorder: FileRecorder | None = None
         if record is not None:
@@ -174,7 +175,10 @@ class ConsoleApp(App[None]):
         if self.instructor and self.instructor_panel is not None:
             self.instructor_panel.show_faults(sim)
         self.function_bar.set_armed(self.operator.mode.name if self.operator.mode else None)
-        self.status_bar.update(self.status_text(alarms=sum(not a.acknowledged for a in alarms)))
+        status = self.status_text(alarms=sum(not a.acknowledged for a in alarms))
+        if status != self._status:
+            self._status = status
+            self.status_bar.update(status)
 
     def status_text(self, alarms: int) -> Text:
         sim = self.sim
@@ -345,8 +349,10 @@ class ConsoleApp(App[None]):
     async def _password_given(self, given: str | None) -> None:
         if given == self.password:
             await self.set_instructor(True)
-        else:
+        elif given:
             self.say("wrong instructor password", False)
+        else:
+            self.say("instructor mode not opened")
 
     async def set_instructor(self, on: bool) -> None:
         if on and self.instructor_panel is None:

@@ -69,6 +69,7 @@ class Diagram(ScrollView, can_focus=True):
         self.cursor: Ref | None = None
         self._drag: tuple[int, int, float, float] | None = None
         self._centred = False
+        self._shown_pressed: set[Ref] = set()
 
     # ---- layout ----
     @property
@@ -134,9 +135,12 @@ class Diagram(ScrollView, can_focus=True):
 
     # ---- drawing ----
     def update_view(self) -> None:
-        """Read the simulation again and redraw (called by the console's clock)."""
+        """Read the simulation again; redraw when what is shown changed (called by the console's clock)."""
+        before, pressed = self._frame, self._pressed()
         self._frame = None
-        self.refresh()
+        if self.layout_ is None or before is None or self.frame() != before or pressed != self._shown_pressed:
+            self._shown_pressed = pressed
+            self.refresh()
 
     def frame(self) -> Frame:
         if self._frame is None:

@@ -89,7 +89,8 @@ def read_frame(sim: Simulation, lay: Layout) -> Frame:
     doors: dict[str, str] = {}
     for key, d in sim.field.doors.items():
         doors[key] = "bypass" if d.pdqcj else "open" if d.is_open else "closed"
-    return Frame(sections, turnouts, lamps, countdown, alarmed, doors, int(sim.t * 2) % 2 == 0)
+    lost = any(pos is None for pos, _ in turnouts.values())
+    return Frame(sections, turnouts, lamps, countdown, alarmed, doors, int(sim.t * 2) % 2 == 0 if lost else True)
 
 
 def add_overlays(frame: Frame, sim: Simulation, lay: Layout) -> None:
