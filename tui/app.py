@@ -189,6 +189,9 @@ class ConsoleApp(App[None]):
         out.append(f"{self.speed:g}x ")
         if alarms:
             out.append(f"│ ⚠ {alarms} alarm{'s' if alarms > 1 else ''} ", style="bold #ff4040")
+        counting = self.diagram.frame().countdown if self.diagram.layout_ is not None else {}
+        if counting:
+            out.append("│ 人解 " + " ".join(f"{s} {n}s" for s, n in sorted(counting.items())) + " ", style="#ffd700")
         out.append("│ 教员 INSTRUCTOR " if self.instructor else "│ trainee ", style="#d0a0ff" if self.instructor
                    else "")
         if self.exercise is not None:

@@ -78,7 +78,8 @@ class Layout:
     grid: list[list[Glyph | None]]
     targets: dict[Ref, tuple[int, int]] = field(default_factory=dict)  # first cell of every clickable element
     lamp_slots: dict[str, list[tuple[int, int]]] = field(default_factory=dict)
-    countdown_at: dict[str, tuple[int, int, int]] = field(default_factory=dict)  # signal -> (x, y, step)
+    # signal -> places for its release countdown, best first: (x, y, step) where the text starts and grows by step
+    countdown_at: dict[str, list[tuple[int, int, int]]] = field(default_factory=dict)
     section_cells: dict[str, list[tuple[int, int]]] = field(default_factory=dict)
     lpr: int = 3
     zoom: int = 1
@@ -464,8 +465,10 @@ def _paint(b: _Builder, col: list[int], lay: Layout) -> None:
         if sig_refs:
             step = 1 if it.cells[-1][0] > it.cells[0][0] else -1
             outer = col[it.pos] + (it.hi + 2 if step > 0 else it.lo - 2)
+            # beyond the name on the same line, else on the next line out, under (over) the name
+            beside = (col[it.pos] + (it.hi if step > 0 else it.lo), it.line - step, -step)
             for r in {r.id for r in sig_refs}:
-                lay.countdown_at[r] = (outer, it.line, step)
+                lay.countdown_at[r] = [(outer, it.line, step), beside]
     _paint_platforms(b, lay, cx, cy)
 
 

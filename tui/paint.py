@@ -97,15 +97,14 @@ def add_overlays(frame: Frame, sim: Simulation, lay: Layout) -> None:
     """Countdowns beside their signals and train names over the sections they occupy."""
     ov = frame.overlay
     for sig, secs in frame.countdown.items():
-        at = lay.countdown_at.get(sig)
-        if at is None:
-            continue
-        x, y, step = at
         text = f"{secs}s"
-        xs = range(x, x + len(text)) if step > 0 else range(x - len(text) + 1, x + 1)
-        if all(lay.at(cx, y) is None for cx in xs):
-            for cx, ch in zip(xs, text, strict=True):
-                ov[(cx, y)] = (ch, S_COUNT)
+        for x, y, step in lay.countdown_at.get(sig, []):
+            xs = range(x, x + len(text)) if step > 0 else range(x - len(text) + 1, x + 1)
+            if xs.start >= 0 and xs.stop <= lay.width and 0 <= y < lay.height and \
+                    all(lay.at(cx, y) is None and (cx, y) not in ov for cx in xs):
+                for cx, ch in zip(xs, text, strict=True):
+                    ov[(cx, y)] = (ch, S_COUNT)
+                break
     for tv in sim.train_views():
         cells = sorted({c for s in tv.sections for c in lay.section_cells.get(s, [])}, key=lambda c: (c[1], c[0]))
         if not cells:
