@@ -137,6 +137,10 @@ class ConsoleApp(App[None]):
             self.load_exercise(str(self._exercise_arg))
         self.refresh_views()
         self.set_interval(TICK_S, self.tick)
+        self.started()
+
+    def started(self) -> None:
+        """After mounting (Textual calls every class's on_mount, so subclasses extend this instead)."""
 
     def on_unmount(self) -> None:
         if self.recorder is not None:

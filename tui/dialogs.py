@@ -103,26 +103,27 @@ class PasswordScreen(ModalScreen[str]):
 
 
 HELP = """\
-操作表示机 Operator console — keys and mouse
+操作表示机 Operator console: keys and mouse
 
-Set a route: click the start button (L train / D shunting, next to the signal), optional
-variant buttons, then the end button. Esc drops the selection.
-Function buttons (bottom bar, or their key), then click the signal / turnout / section:
-  c 总取消 cancel    r 总人解 manual release   f 区故解 section fault release
-  g 引导 guide       G 引导总锁 guide total lock (toggles)   o 重开 reopen
-  n 总定位 normal    v 总反位 reverse   l 单锁 lock   u 单解 unlock   b 单封 block   B 解封 unblock
-Click a turnout number, a signal or a section band for its menu.
+Route: click the start button (L train, D shunting), any variant
+buttons, then the end button. Esc drops the selection.
+Function button (bottom bar or key), then the signal / turnout / section:
+  c 总取消 cancel        r 总人解 release      f 区故解 fault release
+  g 引导 guide           G 引导总锁 guide lock  o 重开 reopen
+  n 总定位 normal        v 总反位 reverse
+  l 单锁 lock   u 单解 unlock   b 单封 block   B 解封 unblock
+Click a turnout number, a signal or a section for its menu.
 
-Keyboard: arrows move the cursor between elements, Enter presses; shift+arrows or the mouse wheel pan;
-+ / - zoom, 0 fit.   : command bar (Tab completes, Up/Down history, Esc back)
-Clock: space pause/run, . one cycle, > faster, < slower.   a acknowledge alarms
-F2 instructor panel (faults, trains, exercises).   ctrl+q quit.
-Replay: [ ] seek 10 s, { } seek 60 s, home / end.
+Arrows move the cursor, Enter presses it. Shift+arrows or the wheel
+pan; + - zoom, 0 fits.   : command bar (Tab, Up/Down, Esc)
+space pause/run   . one cycle   > < speed   a acknowledge alarms
+F2 instructor panel   ? this help   ctrl+q quit
+Replay: [ ] seek 10 s, { } 60 s, Home / End
 """
 
 
 class HelpScreen(ModalScreen[None]):
-    DEFAULT_CSS = DIALOG_CSS.format(name="HelpScreen") + "HelpScreen > Vertical { width: 100; }"
+    DEFAULT_CSS = DIALOG_CSS.format(name="HelpScreen") + "HelpScreen > Vertical { width: 78; }"
     BINDINGS: ClassVar[list[BindingType]] = [Binding("escape,q,question_mark,f1", "close", "close")]
 
     def compose(self) -> ComposeResult:

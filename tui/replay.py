@@ -40,8 +40,7 @@ class ReplayApp(ConsoleApp):
         super().__init__(rec.station, paused=paused, speed=speed, sim=self.replayer.sim)
         self.warm_up = False  # the recording has its own first cycle
 
-    def on_mount(self) -> None:
-        super().on_mount()
+    def started(self) -> None:
         log = self.log_panel
         log.add(f"replay of {self.rec.path}: {self.rec.duration:g} s, {len(self.rec.commands)} commands", "bold")
         self.say("replay: space play/pause, [ ] seek 10 s, { } 60 s, Home/End, > < speed, ': seek 2min'")
