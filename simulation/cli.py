@@ -174,6 +174,9 @@ def build_parser() -> argparse.ArgumentParser:
     from .verify.cli import register as register_verify
 
     register_verify(add)
+    from .soakcli import register as register_soak
+
+    register_soak(add)
     _register_plugins(add)
     return p
 

@@ -10,7 +10,9 @@ tests:
       - expect signal X U
 ```
 Each test runs on a fresh simulation. A command that is refused fails the test unless the next step is
-``expect refused ...``. A failing step prints the step, what was expected and what the state was.
+``expect refused ...``. A failing step prints the step, what was expected and what the state was. With
+``safety: true`` a :class:`~simulation.safety.SafetyChecker` watches every cycle and a violation of a safety property
+fails the test at the step where it happens (``liansuo soak`` writes its reproducers this way).
 """
 
 from __future__ import annotations
@@ -45,6 +47,7 @@ class Script:
     station: str
     tests: list[ScriptTest]
     cycle_s: float = 0.25
+    safety: bool = False  # check the safety properties every cycle
 
 
 @dataclass
@@ -65,9 +68,9 @@ def parse_script(path: Path) -> Script:
         raise StationError([src.diagnostic((), "a test script is a mapping with 'station:' and 'tests:'",
                                            "see examples/ for scripts")])
     for key in data:
-        if key not in ("station", "tests", "cycle_ms"):
+        if key not in ("station", "tests", "cycle_ms", "safety"):
             errors.append(src.diagnostic((key,), f"unknown key '{key}'", "a script has station, tests and "
-                                         "optionally cycle_ms", at_key=True))
+                                         "optionally cycle_ms and safety", at_key=True))
     station = data.get("station")
     if not isinstance(station, str):
         errors.append(src.diagnostic(("station",) if "station" in data else (), "missing or invalid 'station:'",
@@ -100,9 +103,13 @@ def parse_script(path: Path) -> Script:
     if not isinstance(cycle_ms, int | float) or isinstance(cycle_ms, bool) or not 10 <= cycle_ms <= 2000:
         errors.append(src.diagnostic(("cycle_ms",), "cycle_ms must be a number from 10 to 2000", ""))
         cycle_ms = 250
+    safety = data.get("safety", False)
+    if not isinstance(safety, bool):
+        errors.append(src.diagnostic(("safety",), "safety must be true or false", ""))
+        safety = False
     if errors:
         raise StationError(errors)
-    return Script(str(path), str(station), tests, cycle_ms / 1000.0)
+    return Script(str(path), str(station), tests, cycle_ms / 1000.0, safety)
 
 
 def _resolve_station(script: Script, src_dir: Path) -> Station:
@@ -130,11 +137,20 @@ def run_script(script: Script, only: str | None = None) -> list[Outcome]:
 
 def run_test(script: Script, test: ScriptTest, station: Station, table: object) -> Outcome:
     sim = Simulation(station, cycle_s=script.cycle_s, table=table)  # type: ignore[arg-type]
+    checker = None
+    if script.safety:
+        from .safety import SafetyChecker
+
+        checker = SafetyChecker(sim)
     log: list[str] = []
     steps = test.steps
     for k, step in enumerate(steps):
         result = sim.command(step.text)
         log.append(f"{step.text} -> {'ok' if result.ok else 'refused'}: {result.message}")
+        if checker is not None and checker.violations:
+            v = checker.violations[0]
+            return Outcome(script.file, test.name, False, f"step '{step.text}': safety violation at t = {v.t:g} s "
+                           f"({v.prop}): {v.text}", step.line, log)
         is_expect = step.text.strip().startswith("expect")
         if result.ok:
             continue
