@@ -19,7 +19,7 @@ from textual.binding import Binding, BindingType
 from textual.containers import Horizontal, Vertical
 from textual.widgets import Footer
 
-from interlocking.io import Result
+from simulation import Result
 from simulation.exercise import Exercise, GoalCheck, bundled_exercises, check_goal, parse_exercise
 from simulation.recording import FileRecorder
 from simulation.sim import Simulation

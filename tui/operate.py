@@ -13,12 +13,11 @@ the next press on the diagram names its target. Those a real console asks to con
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Literal
 
 from .layout import Ref
 
 if TYPE_CHECKING:
-    from interlocking.table import Kind
     from simulation.sim import Simulation
 
 
@@ -171,7 +170,7 @@ class Operator:
             self.start, self.via = (ref.id, ref.sub), []
             return Outcome(message=self.prompt())
         start, kind_word = self.start
-        kind: Kind = "train" if kind_word == "train" else "shunt"
+        kind: Literal["train", "shunt"] = "train" if kind_word == "train" else "shunt"
         if (ref.id, ref.sub) == self.start:
             self.reset()
             return Outcome(message="route selection dropped")

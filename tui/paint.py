@@ -15,8 +15,6 @@ from typing import TYPE_CHECKING
 
 from rich.style import Style
 
-from interlocking.state import RouteStage
-
 from .layout import Glyph, Layout, Ref
 
 if TYPE_CHECKING:
@@ -82,7 +80,7 @@ def read_frame(sim: Simulation, lay: Layout) -> Frame:
         lamps[sig.id] = [(lamp, lamp in lit) for lamp in shown]
     countdown: dict[str, int] = {}
     for rs in il.routes.values():
-        if rs.stage is RouteStage.time_release and rs.release_at is not None:
+        if sim.route_state(rs.id) == "time_release" and rs.release_at is not None:
             countdown[rs.route.signal] = max(0, int(rs.release_at - sim.t + 0.999))
     alarmed = {key.split(":")[1] for key in il.alarms if key.startswith(("closed:", "lamp:", "red:", "filament:",
                                                                           "flasher:"))}

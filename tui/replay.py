@@ -14,7 +14,7 @@ from typing import ClassVar
 from rich.text import Text
 from textual.binding import Binding, BindingType
 
-from interlocking.io import Result
+from simulation import Result
 from simulation.recording import Recording, Replayer
 from simulation.timeparse import parse_duration
 
