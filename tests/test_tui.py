@@ -358,3 +358,17 @@ async def test_recording_and_replay_reproduce_the_session(tmp_path: Path) -> Non
         assert replay.sim.t == pytest.approx(min(10.0, rec.duration))
         await click(pilot, Ref("button", "S", "train"))
         assert "replay" in message(replay)
+
+
+def test_variant_buttons_become_the_via_of_the_route() -> None:
+    from simulation import Simulation
+    from tui.operate import Operator
+
+    sim = Simulation("gaotie")
+    op = Operator(sim)
+    assert op.press(Ref("button", "X", "train")).command == ""
+    assert "via BA1" in op.press(Ref("button", "BA1", "variant")).message
+    out = op.press(Ref("button", "XI", "train"))
+    assert out.command == "route X BA1 XI"
+    assert sim.command(out.command).ok
+    assert op.press(Ref("button", "XFCK", "exit")).message.startswith("XFCK is an end button")
