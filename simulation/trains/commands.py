@@ -188,7 +188,7 @@ def _slip(sim: Simulation, args: list[str]) -> Result:
         return Result.refuse("RATIO must lie between -0.9 (a locked wheel slides) and 2 (a wheel spinning 3x)")
     tr = sim.fleet.trains[name]
     tr.slip_ratio, tr.slip_until = ratio, sim.fleet.t + seconds
-    tr.extra["slip_from"] = sim.fleet.t
+    tr.slip_from = sim.fleet.t
     what = "slipping" if ratio > 0 else "sliding"
     return Result.accept(f"train {name}: wheels {what} {abs(ratio) * 100:g} % for {seconds:g} s")
 

@@ -58,6 +58,7 @@ class Train:
     odometer: Odometer = field(default_factory=Odometer)  # on-board speed and distance measurement (seed 001)
     travelled_m: float = 0.0  # the true distance run since placed (what the odometer estimates)
     slip_ratio: float = 0.0  # wheel speed / true speed - 1 while an injected slip (> 0) or slide (< 0) lasts
+    slip_from: float = 0.0
     slip_until: float = 0.0
     extra: dict[str, object] = field(default_factory=dict)
 
@@ -139,7 +140,7 @@ class Fleet:
         slip = 0.0
         if tr.slip_ratio and self.t < tr.slip_until + SLIP_RAMP_S:
             # a slip or slide builds up and dies away over about a second rather than jumping
-            since = self.t - float(tr.extra.get("slip_from", self.t))
+            since = self.t - tr.slip_from
             slip = tr.slip_ratio * max(0.0, min(1.0, since / SLIP_RAMP_S, (tr.slip_until + SLIP_RAMP_S - self.t)
                                                  / SLIP_RAMP_S))
         before = tr.travelled_m
