@@ -25,7 +25,7 @@ class DoorFaults:
 
 @dataclass
 class PlatformDoors:
-    key: str  # "P3:left"
+    key: str  # "P3:right"
     opening: float = 0.0  # 0 closed and locked, 1 fully open
     moving: int = 0  # +1 opening, -1 closing, 0 still
     faults: DoorFaults = field(default_factory=DoorFaults)

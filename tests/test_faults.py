@@ -108,7 +108,7 @@ def test_usu_flashes_at_the_modelled_rate(gaotie: Driver) -> None:
 
 # ---- screen doors ------------------------------------------------------------------------------------------------
 def test_psd_faults_at_relay_level(gaotie: Driver) -> None:
-    doors = gaotie.sim.field.doors["P3:left"]
+    doors = gaotie.sim.field.doors["P3:right"]
     gaotie("fault psd-stuck P3")
     assert not doors.pdkj
     gaotie("repair psd-stuck P3", "fault psd-bypass P3")

@@ -78,22 +78,22 @@ def test_signal_onto_platform_track_needs_doors_closed_and_locked_or_bypassed(ga
 
 def test_losing_door_proof_closes_the_departure_signal(gaotie: Driver) -> None:
     gaotie("route X3 XFCK", "run 10s", "expect signal X3 L", "fault psd-stuck P3", "run 1s", "expect signal X3 H",
-           "expect alarm screen doors P3:left")
+           "expect alarm screen doors P3:right")
 
 
 def test_doors_open_only_with_a_train_at_the_platform(gaotie: Driver) -> None:
     gaotie.refused("doors P3 open", "no train at platform P3")
     gaotie("occupy 3G", "doors P3 open", "run 4s")
-    assert gaotie.sim.field.doors["P3:left"].is_open
+    assert gaotie.sim.field.doors["P3:right"].is_open
     gaotie("doors P3 close", "run 5s")
-    assert not gaotie.sim.field.doors["P3:left"].is_open
+    assert not gaotie.sim.field.doors["P3:right"].is_open
 
 
 def test_doors_do_not_open_when_platform_occupancy_is_disturbed_or_close_when_gmj_failed(gaotie: Driver) -> None:
     gaotie("fault psd-no-open P3", "occupy 3G", "doors P3 open", "run 4s")
-    assert not gaotie.sim.field.doors["P3:left"].is_open
+    assert not gaotie.sim.field.doors["P3:right"].is_open
     gaotie("repair psd-no-open P3", "fault psd-no-close P3", "doors P3 open", "run 4s", "doors P3 close", "run 5s")
-    assert gaotie.sim.field.doors["P3:left"].is_open
+    assert gaotie.sim.field.doors["P3:right"].is_open
     gaotie("route X3 XFCK", "run 10s", "expect signal X3 H")
 
 

@@ -113,7 +113,7 @@ def test_platform_stop_in_the_window_doors_linked_and_departure_only_with_doors_
     gaotie("train G2 at IAG kind=emu mode=signal back=900 stop=P3", "route X X3", "run 150s")
     g = gaotie.sim.fleet.trains["G2"]
     assert g.platform_stop is not None and g.platform_stop.state == "doors_open"
-    assert g.train_doors_open and gaotie.sim.field.doors["P3:left"].is_open
+    assert g.train_doors_open and gaotie.sim.field.doors["P3:right"].is_open
     gaotie("route X3 XFCK", "run 2s", "expect signal X3 H")  # the screen doors are open
     gaotie("run 60s")
     assert not g.train_doors_open
