@@ -174,6 +174,7 @@ class RouteTest:
         if not self.check(p.closed(r.signal), "no-indication", f"turnout {t} lost its indication: signal {r.signal} "
                           f"still shows {p.aspect(r.signal)}", p):
             return
+        self.closing_alarm(p)
         p.do(f"repair no-indication {t}")
         p.run(5.0)
         if not self.check(p.closed(r.signal), "no-automatic-reopening", f"signal {r.signal} reopened by itself "
@@ -183,6 +184,13 @@ class RouteTest:
         p.run(1.0)
         self.check(result.ok and p.is_open(r.signal), "reopen", f"'reopen {r.signal}' after the repair: "
                    f"{result.message}; signal shows {p.aspect(r.signal)}", p)
+
+    def closing_alarm(self, p: Probe) -> None:
+        """A signal closed abnormally raises an alarm (非正常关闭报警)."""
+        sig = self.r.signal
+        alarms = p.sim.alarm_texts()
+        self.check(any(f"signal {sig} closed" in a for a in alarms), "closing-alarm",
+                   f"signal {sig} closed abnormally without an alarm (alarms: {'; '.join(alarms) or 'none'})", p)
 
     # ---- sections -----------------------------------------------------------------------------------------------
     def section_occupied(self, s: str) -> None:
@@ -205,6 +213,7 @@ class RouteTest:
         if not self.check(p.closed(r.signal), "section-occupied", f"section {s} occupied: signal {r.signal} still "
                           f"shows {p.aspect(r.signal)}", p):
             return
+        self.closing_alarm(p)
         p.do(f"vacate {s}")
         p.run(5.0)
         if not self.check(p.closed(r.signal), "no-automatic-reopening", f"signal {r.signal} reopened by itself "
