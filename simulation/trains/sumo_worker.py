@@ -38,6 +38,8 @@ TOLERANCE_M = 0.01
 class _Vehicle:
     train: str
     vtype: str
+    accel: float
+    decel: float
     vid: str = ""
     route: tuple[str, ...] = ()
     target: float = -1.0
@@ -144,7 +146,7 @@ class SumoWorld:
             vt.setImperfection(vtype, 0.0)
             vt.setSpeedFactor(vtype, 1.0)
             vt.setSpeedDeviation(vtype, 0.0)
-            self.vehicles[name] = _Vehicle(name, vtype)
+            self.vehicles[name] = _Vehicle(name, vtype, float(accel), float(decel))
         for tls, state in p.get("tls", {}).items():
             s.trafficlight.setRedYellowGreenState(tls, state)
         present = set(veh.getIDList())
@@ -157,6 +159,7 @@ class SumoWorld:
         trains: dict[str, tuple[float, float | None, Sequence[str] | None, float, float]] = p["trains"]
         force: dict[str, float] = p.get("force", {})
         before: dict[str, float] = {}
+        speeds: dict[str, float] = {}
         for name, (target, _limit, new_route, pos, speed) in trains.items():
             rec = self.vehicles[name]
             route = tuple(new_route) if new_route is not None else rec.route
@@ -179,6 +182,7 @@ class SumoWorld:
                 veh.setSpeed(rec.vid, max(target, 0.0))
                 rec.target = target
             before[name] = float(veh.getDistance(rec.vid))
+            speeds[name] = float(veh.getSpeed(rec.vid))
         s.simulationStep(float(s.simulation.getTime()) + float(p["dt"]))
         present = set(veh.getIDList())
         out: dict[str, tuple[float, float]] = {}
@@ -187,9 +191,12 @@ class SumoWorld:
             if rec.vid in present:
                 v = float(veh.getSpeed(rec.vid))
                 ds = float(veh.getDistance(rec.vid)) - before[name]
-            else:  # ran off the end of its route (a buffer stop or the end of the way ahead) and arrived
-                v = max(target, 0.0)
-                ds = self._remaining(rec.route, pos)
+            else:  # ran off the end of its route (a buffer stop, a turnout in no end position) and arrived:
+                # what SUMO's step did (explicit Euler), so our model takes the train past the end and stops it
+                # at the buffer or derails it at the turnout
+                v0, dt = speeds[name], float(p["dt"])
+                v = min(target, v0 + rec.accel * dt) if v0 < target else max(target, v0 - rec.decel * dt)
+                ds = max(v * dt, self._remaining(rec.route, pos))
                 rec.vid = ""
             if limit is not None and ds >= limit:
                 ds, v = max(limit, 0.0), 0.0  # the exact stopping point; the vehicle is put back next cycle
