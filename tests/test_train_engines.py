@@ -91,6 +91,31 @@ def test_platform_stop_within_the_stopping_window(make: Make) -> None:
     no_engine_alarm(d)
 
 
+def test_facing_move_onto_a_moving_turnout_derails(make: Make) -> None:
+    d = make("jiaopei")
+    d("fault high-resistance 1", "throw 1 reverse", "train T1 at 7DG length=40 back=10", "drive T1 20", "run 20s",
+      "expect alarm derailed at turnout 1")
+    assert d.sim.train_views()[0].speed_kmh == 0.0
+    no_engine_alarm(d)
+
+
+def test_train_stops_at_the_buffer_stop(make: Make) -> None:
+    d = make("jiaopei")
+    d("train L1 at QXG kind=shunter dir=up back=30", "drive L1 10", "run 90s")
+    assert any("train L1 stopped at buffer stop BQX" in e for e in d.sim.event_texts())
+    v = d.sim.train_views()[0]
+    assert v.speed_kmh == 0.0 and v.head_m == pytest.approx(120.0, abs=0.01)
+    no_engine_alarm(d)
+
+
+def test_shunter_draws_back_after_reversing_and_the_route_releases(make: Make) -> None:
+    d = make("jiaopei")
+    d("train L1 at QXG kind=shunter mode=signal back=30", "shunt D1 SI", "run 5s", "expect signal D1 B",
+      "drive L1 10", "run 25s", "stop L1", "run 10s", "expect section 7DG occupied", "reverse L1", "drive L1 10",
+      "run 30s", "stop L1", "run 5s", "expect section 7DG free", "expect route D1 SI released")
+    no_engine_alarm(d)
+
+
 @pytest.mark.parametrize("scenario", SCENARIOS, ids=[p.stem for p in SCENARIOS])
 def test_every_example_scenario_runs_without_a_refused_step(scenario: Path, engine: str) -> None:
     out: list[str] = []
