@@ -247,6 +247,10 @@ class Interlocking(Engine):
             if rs.stage not in (RouteStage.locked, RouteStage.setting) or rs.entered:
                 return Result.refuse(f"route {rs.id} is {rs.stage.value}; a guide route needs a locked route "
                                      "whose signal is closed")
+            released = [s for i, s in enumerate(rs.route.sections) if rs.released[i]]
+            if released:  # e.g. by section fault release: its turnouts are no longer locked
+                return Result.refuse(f"guide refused: section {released[0]} of route {rs.id} has been released; "
+                                     "cancel the route and set it again")
             blocker = self.open_blocker(rs, guide=True)
             if blocker.startswith("turnout") or blocker.startswith("block") or blocker.startswith("screen"):
                 return Result.refuse(f"guide refused: {blocker}")
