@@ -311,9 +311,13 @@ class SafetyChecker:
             if m.faults.squeezed:
                 self._lock_at[t] = (m.rails, None)  # trailed through (挤岔): the train's doing, not a command
                 continue
+            # where it lies or was going when locked; a machine retrying that same position (an obstruction keeps
+            # the lock from engaging) moves nothing
+            allowed = {p for p in (rails, target) if p is not None}
             driven = il.out.turnouts.get(t)
-            moving = m.running and m.target != target
-            moved = m.rails != rails and m.rails != target
-            if moving or moved or (driven is not None and driven not in (rails, target)):
+            moving = m.running and m.target not in allowed
+            moved = (m.rails is not None and m.rails not in allowed) or (m.rails is None and rails is not None
+                                                                         and m.target not in allowed)
+            if moving or moved or (driven is not None and driven not in allowed):
                 found[f"moved:{t}"] = ("turnout-moved", f"locked turnout {t} moved: rails {rails} -> {m.rails}, "
                                                         f"driven to {driven}")
