@@ -262,11 +262,16 @@ class Engine:
         leaves out the route's own sections (a shunting consist passing its open signal occupies them), not its
         fouling and overlap sections."""
         r = rs.route
+        if any(rs.released):
+            released = [s for i, s in enumerate(r.sections) if rs.released[i]]
+            return f"section {released[0]} of route {r.id} has been released: the route is no longer locked"
         for t in r.all_turnouts:
             ind = self.board.indication(t.id)
             if ind != t.position.value:
                 what = "has no indication" if ind is None else f"is {ind}"
                 return f"turnout {t.id} {what}, the route needs it {t.position.value}"
+            if t in r.turnouts and rs.id not in self.turnouts[t.id].locks:
+                return f"turnout {t.id} is not locked in route {r.id}"
         if not guide:
             for s in r.all_sections if sections else r.all_sections[len(r.sections):]:
                 if not self.clear(s):

@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING
 
 from interlocking.io import Result
 from interlocking.table import Kind
+from stations.source import Diagnostic, Source
 
 from .timeparse import parse_duration
 
@@ -302,6 +303,25 @@ COMMANDS: dict[str, Handler] = {
     "run": _run,
     "expect": _expect,
 }
+
+
+def read_steps(src: Source, loc: tuple[str | int, ...], raw: object, errors: list[Diagnostic]) -> list[tuple[str, int]]:
+    """The commands of a YAML list at ``loc`` in a script, scenario or exercise, with their lines; a step that is
+    not text or names no known command becomes a diagnostic at its position."""
+    steps: list[tuple[str, int]] = []
+    if not isinstance(raw, list):
+        return steps
+    for i, s in enumerate(raw):
+        at = (*loc, i)
+        if not isinstance(s, str):
+            errors.append(src.diagnostic(at, "a step is one command as text", "quote it if it contains ':'"))
+            continue
+        word = s.split("#", 1)[0].split()[:1]
+        if word and word[0] not in COMMANDS:
+            errors.append(src.diagnostic(at, f"unknown command '{word[0]}'",
+                                         f"commands: {', '.join(sorted(COMMANDS))}"))
+        steps.append((s, src.mark(at).line))
+    return steps
 
 
 def _with_trains() -> None:

@@ -23,7 +23,7 @@ from pathlib import Path
 from stations.library import bundled
 from stations.source import Diagnostic, StationError, read_file
 
-from .commands import COMMANDS
+from .commands import read_steps
 from .sim import Simulation
 
 KEYS = ("title", "station", "description", "setup", "goal")
@@ -72,15 +72,7 @@ def parse_exercise(path: str | Path) -> Exercise:
     if not isinstance(raw, list):
         errors.append(src.diagnostic(("setup",), "'setup:' is a list of commands", ""))
         raw = []
-    for i, line in enumerate(raw):
-        if not isinstance(line, str):
-            errors.append(src.diagnostic(("setup", i), "a setup step is one command as text", ""))
-            continue
-        word = line.split("#", 1)[0].split()[:1]
-        if word and word[0] not in COMMANDS:
-            errors.append(src.diagnostic(("setup", i), f"unknown command '{word[0]}'",
-                                         f"commands: {', '.join(sorted(COMMANDS))}"))
-        setup.append(line)
+    setup = [s for s, _ in read_steps(src, ("setup",), raw, errors)]
     goal = data.get("goal", {}) or {}
     expect: list[str] = []
     if not isinstance(goal, dict):

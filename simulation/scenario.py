@@ -21,7 +21,7 @@ from pathlib import Path
 from stations.loader import load
 from stations.source import Diagnostic, StationError, read_file
 
-from .commands import COMMANDS
+from .commands import read_steps
 from .sim import Simulation
 from .timeparse import parse_duration
 
@@ -54,16 +54,7 @@ def parse_scenario(path: Path) -> Scenario:
         errors.append(src.diagnostic(("steps",) if "steps" in data else (), "'steps:' must be a list of commands",
                                      ""))
     else:
-        for i, s in enumerate(steps_raw):
-            line = src.mark(("steps", i)).line
-            if not isinstance(s, str):
-                errors.append(src.diagnostic(("steps", i), "a step is one command as text", ""))
-                continue
-            word = s.split("#", 1)[0].split()[:1]
-            if word and word[0] not in COMMANDS:
-                errors.append(src.diagnostic(("steps", i), f"unknown command '{word[0]}'",
-                                             f"commands: {', '.join(sorted(COMMANDS))}"))
-            steps.append((s, line))
+        steps = read_steps(src, ("steps",), steps_raw, errors)
     until = None
     if "until" in data:
         try:

@@ -24,7 +24,7 @@ from stations.loader import load
 from stations.source import Diagnostic, StationError, read_file
 from stations.station import Station
 
-from .commands import COMMANDS
+from .commands import read_steps
 from .sim import Simulation
 
 
@@ -87,17 +87,7 @@ def parse_script(path: Path) -> Script:
         for key in t:
             if key not in ("name", "steps"):
                 errors.append(src.diagnostic(("tests", i, key), f"unknown key '{key}' in a test", "", at_key=True))
-        steps = []
-        for j, s in enumerate(t["steps"]):
-            if not isinstance(s, str):
-                errors.append(src.diagnostic(("tests", i, "steps", j), "a step is one command as text",
-                                             "quote it if it contains ':'"))
-                continue
-            word = s.split("#", 1)[0].split()[:1]
-            if word and word[0] not in COMMANDS:
-                errors.append(src.diagnostic(("tests", i, "steps", j), f"unknown command '{word[0]}'",
-                                             f"commands: {', '.join(sorted(COMMANDS))}"))
-            steps.append(Step(s, src.mark(("tests", i, "steps", j)).line))
+        steps = [Step(s, line) for s, line in read_steps(src, ("tests", i, "steps"), t["steps"], errors)]
         tests.append(ScriptTest(t["name"], steps, src.mark(("tests", i)).line))
     cycle_ms = data.get("cycle_ms", 250)
     if not isinstance(cycle_ms, int | float) or isinstance(cycle_ms, bool) or not 10 <= cycle_ms <= 2000:

@@ -123,3 +123,12 @@ def test_overlap_is_part_of_the_table_and_of_conflicts() -> None:
     r = table.routes["X-XI"]
     assert r.overlap_sections == ("2DG",)
     assert "XI-S" in r.conflicts and "X-XI" in table.routes["XI-S"].conflicts
+
+
+def test_a_route_partly_released_by_section_fault_release_never_opens(jiaopei: Driver) -> None:
+    # found by the safety properties: the signal opened over a turnout whose section had been fault-released
+    jiaopei("block-line XL request", "run 1s", "route SI X", "fault-release 1DG", "run 5s", "expect signal SI H",
+            "expect turnout 1 normal")
+    _, locked = jiaopei.sim.turnout_state("1")
+    assert not locked
+    jiaopei.refused("reopen SI", "has been released")
