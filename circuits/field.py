@@ -79,14 +79,13 @@ class Field:
         self.circuits[section].k_switch = False
         self._reevaluate(section)
 
-    def set_axles(self, axles: Iterable[Axle]) -> None:
-        """Where every wheelset stands now; sections whose shunts changed are re-evaluated."""
+    def set_axles(self, axles: Iterable[Axle], more: dict[str, list[tuple[float, float]]] | None = None) -> None:
+        """Where every wheelset stands now (and ``more`` shunts already worked out by section, e.g. a train's);
+        sections whose shunts changed are re-evaluated."""
         self.axles = list(axles)
-        shunts: dict[str, list[tuple[float, float]]] = {}
-        for a in self.axles:
-            sh = self.geometry.shunt(a)
-            if sh is not None:
-                shunts.setdefault(sh.section, []).append((sh.distance_m, sh.ohm))
+        shunts = self.geometry.shunts_of(self.axles)
+        for sec, lst in (more or {}).items():
+            shunts.setdefault(sec, []).extend(lst)
         touched = set(shunts) | set(self.shunts)
         old = self.shunts
         self.shunts = shunts

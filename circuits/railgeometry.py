@@ -9,13 +9,14 @@ invisible to the interlocking.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import NamedTuple
 
 from stations.station import Station
 
 
-@dataclass(frozen=True)
-class Axle:
-    """A wheelset standing on ``track`` at position ``x`` (metres along the line), with its shunt resistance."""
+class Axle(NamedTuple):
+    """A wheelset standing on ``track`` at position ``x`` (metres along the line), with its shunt resistance.
+    (A named tuple: trains make hundreds of these every step.)"""
 
     track: str
     x: float
@@ -48,6 +49,24 @@ class RailGeometry:
                 dz = zones.get(p.node)
                 if dz is not None:
                     self.track_dead[tid].append((dz.start, dz.end))
+
+    def shunts_of(self, axles: list[Axle]) -> dict[str, list[tuple[float, float]]]:
+        """The shunts of many wheelsets, by section: the same as ``shunt`` for each, without the call per axle."""
+        out: dict[str, list[tuple[float, float]]] = {}
+        span, dead, tracks = self.track_span, self.track_dead, self.station.tracks
+        low, length = self.section_low, self.section_length
+        for a in axles:
+            lo, hi = span[a.track]
+            x = a.x
+            if not lo - 1e-6 <= x <= hi + 1e-6:
+                continue
+            zones = dead[a.track]
+            if zones and any(z0 <= x < z1 for z0, z1 in zones):
+                continue
+            sec = tracks[a.track].section
+            d = x - low[sec]
+            out.setdefault(sec, []).append((0.0 if d < 0 else min(d, length[sec]), a.ohm))
+        return out
 
     def in_dead_zone(self, track: str, x: float) -> bool:
         return any(lo <= x < hi for lo, hi in self.track_dead[track])

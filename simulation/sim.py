@@ -93,7 +93,7 @@ class Simulation:
 
     def update_axles(self) -> None:
         """Tell the field where every wheelset stands: trains and parked wheelsets."""
-        self.field.set_axles([a for group in self.parked.values() for a in group] + self.fleet.axles())
+        self.field.set_axles([a for group in self.parked.values() for a in group], self.fleet.shunts())
 
     def log(self, kind: str, text: str) -> None:
         self.events.append(Event(self.t, kind, text))

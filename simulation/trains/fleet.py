@@ -22,6 +22,7 @@ from .movement import OUTSIDE, Notify, Position, Track
 from .odometry import Odometer
 
 MODES = ("manual", "signal", "auto")
+WHEEL_OHM = Axle._field_defaults["ohm"]  # a clean wheelset
 SLIP_RAMP_S = 1.0
 
 
@@ -270,10 +271,18 @@ class Fleet:
         return target, why
 
     # ---- what the track circuits and front ends see -----------------------------------------------------------
-    def axles(self) -> list[Axle]:
-        out: list[Axle] = []
+    def shunts(self) -> dict[str, list[tuple[float, float]]]:
+        """The shunts of every train by section; a train that has not moved keeps its last ones."""
+        out: dict[str, list[tuple[float, float]]] = {}
+        geometry = self.field.geometry
         for tr in self.trains.values():
-            out += self.track.axles(tr.pos, tr.consist.axle_offsets_m)
+            key = (len(tr.pos.moves), tr.pos.moves[-1], tr.pos.front_s)
+            cached = tr.extra.get("shunts")
+            if not (isinstance(cached, tuple) and cached[0] == key):
+                cached = (key, self.track.shunts(tr.pos, tr.consist.axle_offsets_m, geometry, WHEEL_OHM))
+                tr.extra["shunts"] = cached
+            for sec, lst in cached[1].items():
+                out.setdefault(sec, []).extend(lst)
         return out
 
     def sections_of(self, tr: Train) -> tuple[str, ...]:

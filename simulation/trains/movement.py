@@ -13,7 +13,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from circuits.field import Field
-from circuits.railgeometry import Axle
+from circuits.railgeometry import Axle, RailGeometry
 from stations.schema import Direction, EndKind
 from stations.station import Station
 from stations.topology import Move
@@ -40,6 +40,8 @@ class Track:
         self.station = station
         self.topo = station.topology
         self.field = fld
+        # per track: (position at its low end, at its high end, length), for the hot path of wheelset positions
+        self._geo = {t: (*station.track_span(t), station.track_length(t)) for t in station.tracks}
 
     def length(self, move: Move) -> float:
         return OUTSIDE_LENGTH if move[0] == OUTSIDE else self.station.track_length(move[0])
@@ -166,19 +168,64 @@ class Track:
 
     # ---- what the track circuits see ------------------------------------------------------------------------
     def axles(self, pos: Position, offsets: tuple[float, ...]) -> list[Axle]:
+        """Where each wheelset stands (``offsets`` behind the front, front first); none on the open line."""
         out: list[Axle] = []
-        idx = len(pos.moves) - 1
+        moves = pos.moves
+        idx = len(moves) - 1
         back_of_move = pos.front_s  # distance from the front to the start of move idx
+        track, down = moves[idx][0], moves[idx][1] is Direction.down
+        geo = self._geo.get(track)
         for off in offsets:
             while off > back_of_move and idx > 0:
                 idx -= 1
-                back_of_move += self.length(pos.moves[idx])
-            move = pos.moves[idx]
-            if move[0] == OUTSIDE or off > back_of_move:
+                track, down = moves[idx][0], moves[idx][1] is Direction.down
+                geo = self._geo.get(track)
+                back_of_move += OUTSIDE_LENGTH if geo is None else geo[2]
+            if geo is None or off > back_of_move:
                 continue
-            s = back_of_move - off
-            out.append(Axle(move[0], self.x_at(move, s)))
+            lo, hi, length = geo
+            frac = (back_of_move - off) / length
+            out.append(Axle(track, lo + (hi - lo) * frac if down else hi - (hi - lo) * frac))
         return out
+
+    def shunts(self, pos: Position, offsets: tuple[float, ...], geometry: RailGeometry,
+               ohm: float) -> dict[str, list[tuple[float, float]]]:
+        """The shunts this train's wheelsets make, by section: ``axles`` and ``RailGeometry.shunts_of`` in one pass,
+        the hot path of a yard full of trains."""
+        out: dict[str, list[tuple[float, float]]] = {}
+        moves = pos.moves
+        idx = len(moves) - 1
+        back_of_move = pos.front_s
+        sections = self.station.tracks
+        seg: tuple[float, float, float, bool, list[tuple[float, float]], float, float, list[tuple[float, float]]] | None
+        seg = None
+
+        def segment(i: int) -> tuple[float, float, float, bool, list[tuple[float, float]], float, float,
+                                     list[tuple[float, float]]] | None:
+            track, d = moves[i]
+            geo = self._geo.get(track)
+            if geo is None:
+                return None
+            sec = sections[track].section
+            return (*geo, d is Direction.down, geometry.track_dead[track], geometry.section_low[sec],
+                    geometry.section_length[sec], out.setdefault(sec, []))
+
+        seg = segment(idx)
+        for off in offsets:
+            while off > back_of_move and idx > 0:
+                idx -= 1
+                seg = segment(idx)
+                back_of_move += OUTSIDE_LENGTH if seg is None else seg[2]
+            if seg is None or off > back_of_move:
+                continue
+            lo, hi, length, down, zones, sec_low, sec_len, bucket = seg
+            frac = (back_of_move - off) / length
+            x = lo + (hi - lo) * frac if down else hi - (hi - lo) * frac
+            if zones and any(z0 <= x < z1 for z0, z1 in zones):
+                continue  # in a dead zone: it shunts nothing
+            d = x - sec_low
+            bucket.append((0.0 if d < 0 else (sec_len if d > sec_len else d), ohm))
+        return {s: v for s, v in out.items() if v}
 
     def trim(self, pos: Position, length: float) -> None:
         """Forget moves wholly behind the rear of the train."""
