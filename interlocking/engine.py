@@ -259,8 +259,8 @@ class Engine:
 
     def open_blocker(self, rs: RouteState, *, guide: bool = False, sections: bool = True) -> str:
         """Why the signal of ``rs`` may not open (or stay open); '' when every condition holds. ``sections=False``
-        leaves out the route's own sections (a shunting consist passing its open signal occupies them), not its
-        fouling and overlap sections."""
+        excuses the occupied stretch of the route's sections from its first one on (a shunting consist passing its
+        open signal occupies them), but no section beyond a clear one, nor the fouling and overlap sections."""
         r = rs.route
         if any(rs.released):
             released = [s for i, s in enumerate(r.sections) if rs.released[i]]
@@ -273,7 +273,11 @@ class Engine:
             if t in r.turnouts and rs.id not in self.turnouts[t.id].locks:
                 return f"turnout {t.id} is not locked in route {r.id}"
         if not guide:
-            for s in r.all_sections if sections else r.all_sections[len(r.sections):]:
+            skip = 0
+            if not sections:
+                while skip < len(r.sections) and not self.clear(r.sections[skip]):
+                    skip += 1
+            for s in r.all_sections[skip:]:
                 if not self.clear(s):
                     return f"section {s} is occupied"
         blocker = self._liaison_blocker(r)

@@ -132,3 +132,9 @@ def test_a_route_partly_released_by_section_fault_release_never_opens(jiaopei: D
     _, locked = jiaopei.sim.turnout_state("1")
     assert not locked
     jiaopei.refused("reopen SI", "has been released")
+
+
+def test_a_shunting_signal_held_for_its_passing_consist_still_sees_an_occupancy_further_on(jiaopei: Driver) -> None:
+    jiaopei("shunt D1 S3", "run 12s", "expect signal D1 B", "occupy QXG", "occupy 7DG", "occupy 1DG", "run 1s",
+            "expect signal D1 B")  # the consist entering: approach and the first sections, contiguous
+    jiaopei("occupy 5DG", "run 1s", "expect signal D1 A", "expect alarm section 5DG is occupied")
