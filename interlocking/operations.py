@@ -124,14 +124,9 @@ class Interlocking(Engine):
             del self.guide_only[signal]
             self.out.set_aspect(signal, stop_aspect(self.station, signal))
             return Result.accept(f"guide aspect of {signal} cancelled")
-        rs, why = self._need_route(signal)
+        rs, why = self._releasable(signal)
         if rs is None:
             return Result.refuse(why)
-        if rs.stage is RouteStage.in_use:
-            return Result.refuse(f"a train has entered route {rs.id}: it releases section by section; use "
-                                 "fault-release for a section that stays locked")
-        if rs.stage is RouteStage.time_release:
-            return Result.refuse(f"route {rs.id} is already being released by manual time release")
         if self.approach_locked(rs):
             occupied = [s for s in rs.route.approach if not self.clear(s)]
             return Result.refuse(f"approach section {', '.join(occupied)} is occupied: route {rs.id} is "
@@ -145,17 +140,24 @@ class Interlocking(Engine):
         if self.out.signals.get(rs.route.signal) != stop_aspect(self.station, rs.route.signal):
             self.close_signal(rs, reason, abnormal=False)
 
-    def release(self, signal: str) -> Result:
-        """总人解: close the signal and release after 180 s (train) / 30 s (shunting), everything still checked."""
+    def _releasable(self, signal: str) -> tuple[RouteState | None, str]:
+        """The route of ``signal`` if it may be cancelled or released by hand, or why not."""
         rs, why = self._need_route(signal)
         if rs is None:
-            return Result.refuse(why)
+            return None, why
         if rs.stage is RouteStage.in_use:
-            return Result.refuse(f"a train has entered route {rs.id}: it releases section by section; use "
-                                 "fault-release for a section that stays locked")
+            return None, (f"a train has entered route {rs.id}: it releases section by section; use "
+                          "fault-release for a section that stays locked")
         if rs.stage is RouteStage.time_release:
             left = (rs.release_at or self.now) - self.now
-            return Result.refuse(f"route {rs.id} is already counting down ({left:.0f} s left)")
+            return None, f"route {rs.id} is already being released by manual time release ({left:.0f} s left)"
+        return rs, ""
+
+    def release(self, signal: str) -> Result:
+        """总人解: close the signal and release after 180 s (train) / 30 s (shunting), everything still checked."""
+        rs, why = self._releasable(signal)
+        if rs is None:
+            return Result.refuse(why)
         if not self.approach_locked(rs):
             self._close_if_open(rs, "route released")
             self.finish(rs, all_sections=True)
