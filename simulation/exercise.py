@@ -55,7 +55,7 @@ class GoalCheck:
 
 def parse_exercise(path: str | Path) -> Exercise:
     """Read and check an exercise file; :class:`StationError` with FILE:LINE:COLUMN diagnostics when malformed."""
-    src = read_file(Path(path))
+    src = read_file(Path(path), "give the path of an exercise file (see examples/exercises/)")
     data = src.data
     errors: list[Diagnostic] = []
     if not isinstance(data, dict):

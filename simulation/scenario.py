@@ -36,7 +36,7 @@ class Scenario:
 
 
 def parse_scenario(path: Path) -> Scenario:
-    src = read_file(path)
+    src = read_file(path, "give the path of a scenario file (see examples/scenarios/)")
     data = src.data
     errors: list[Diagnostic] = []
     if not isinstance(data, dict):

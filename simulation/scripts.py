@@ -61,7 +61,7 @@ class Outcome:
 
 
 def parse_script(path: Path) -> Script:
-    src = read_file(path)
+    src = read_file(path, "give the path of a YAML test script (see examples/scripts/)")
     errors: list[Diagnostic] = []
     data = src.data
     if not isinstance(data, dict):

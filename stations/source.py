@@ -154,12 +154,12 @@ def read_yaml(text: str, file: str) -> Source:
     return src
 
 
-def read_file(path: Path) -> Source:
+def read_file(path: Path, missing_hint: str = "give a bundled station name (see 'liansuo stations') or a path"
+              ) -> Source:
     try:
         text = path.read_text(encoding="utf-8")
     except FileNotFoundError:
-        raise StationError([Diagnostic(str(path), 1, 1, "no such file",
-                                       "give a bundled station name (see 'liansuo stations') or a path")]) from None
+        raise StationError([Diagnostic(str(path), 1, 1, "no such file", missing_hint)]) from None
     except (OSError, UnicodeDecodeError) as exc:
         raise StationError([Diagnostic(str(path), 1, 1, f"cannot read the file: {exc}",
                                        "station files are UTF-8 text")]) from None
