@@ -36,8 +36,38 @@ BRIGHT_MA = 180.0  # lamp current in the lit phase (modelled value, above DJ pic
 DIM_MA = 70.0  # lamp current in the dark phase (not fully off; between DJ release 40 mA and pick-up 140 mA)
 
 
+class _FlasherOutputs:
+    """What both flashers show the rest of the simulator; each defines ``phase_on`` and its relay states."""
+
+    energised: bool
+    snjj_up: bool
+    bad_contact: bool
+    bright_mA: float
+    dim_mA: float
+
+    @property
+    def phase_on(self) -> bool:
+        raise NotImplementedError
+
+    @property
+    def lamp_lit(self) -> bool:
+        """What the flashing lamp actually shows now: dark in the dim phase and whenever the contact is bad."""
+        return self.phase_on and not self.bad_contact
+
+    @property
+    def lamp_current_mA(self) -> float:
+        if not self.energised:
+            return 0.0
+        return self.bright_mA if self.lamp_lit else self.dim_mA
+
+    @property
+    def healthy(self) -> bool:
+        """Flash check (SNJJ up) as the interlocking reads it."""
+        return self.energised and self.snjj_up
+
+
 @dataclass
-class RelayFlasher:
+class RelayFlasher(_FlasherOutputs):
     """Classic RC + relay flasher: SNJ (flasher relay) with capacitor C, resistors R1/R3, and SNJJ (check)."""
 
     supply_V: float = 24.0
@@ -178,29 +208,13 @@ class RelayFlasher:
         """The flasher's lit phase (SNJ up): what a healthy lamp would show now."""
         return self.energised and self.snj_up
 
-    @property
-    def lamp_lit(self) -> bool:
-        """What the flashing lamp actually shows now: dark in the dim phase and whenever the contact is bad."""
-        return self.phase_on and not self.bad_contact
-
-    @property
-    def lamp_current_mA(self) -> float:
-        if not self.energised:
-            return 0.0
-        return self.bright_mA if self.lamp_lit else self.dim_mA
-
-    @property
-    def healthy(self) -> bool:
-        """Flash check (SNJJ up) as the interlocking reads it."""
-        return self.energised and self.snjj_up
-
     def repair(self) -> None:
         self.bad_contact = False
         self.snj_stuck = False
 
 
 @dataclass
-class ElectronicFlasher:
+class ElectronicFlasher(_FlasherOutputs):
     """Improved electronic flasher: fixed rate and 50 % duty, proves the pulsating lamp current."""
 
     rate: float = 35.0  # flashes per minute, set by R9/C6 at the factory and not adjusted in the field
@@ -264,20 +278,6 @@ class ElectronicFlasher:
             return False
         into = (self.time_s - self.started_s) % self.period
         return into < self.duty_fraction * self.period
-
-    @property
-    def lamp_lit(self) -> bool:
-        return self.phase_on and not self.bad_contact
-
-    @property
-    def lamp_current_mA(self) -> float:
-        if not self.energised:
-            return 0.0
-        return self.bright_mA if self.lamp_lit else self.dim_mA
-
-    @property
-    def healthy(self) -> bool:
-        return self.energised and self.snjj_up
 
     def repair(self) -> None:
         self.bad_contact = False

@@ -62,22 +62,12 @@ class PairTest:
         if not self.ctx.record(p.do(route_line(a)).ok, "pair-setup", a.id,
                                f"'{route_line(a)}' was refused on a fresh station", p):
             return
-        for b in rivals:
-            result = p.do(route_line(b))
-            if not result.ok:
-                self.ctx.record(True, "conflict", f"{a.id} + {b.id}", "")
-                continue
-            self.replay_conflict(a, b, "setting")
+        if not self._rivals_refused(p, a, rivals, "setting"):
             return
         if not p.until(lambda: p.state(a) == "open", SETTLE_S):
             self.ctx.record(False, "pair-setup", a.id, f"signal {a.signal} did not open: {p.blocker(a)}", p)
             return
-        for b in rivals:
-            result = p.do(route_line(b))
-            if not result.ok:
-                self.ctx.record(True, "conflict", f"{a.id} + {b.id}", "")
-                continue
-            self.replay_conflict(a, b, "open")
+        if not self._rivals_refused(p, a, rivals, "open"):
             return
         for b in later:
             ok = open_route(p, b, timeout_s=SETTLE_S) and p.state(a) == "open"
@@ -90,6 +80,15 @@ class PairTest:
                 p = Probe(self.ctx)  # could not get back to 'a alone': start again for the rest
                 if not open_route(p, a, timeout_s=SETTLE_S):
                     return
+
+    def _rivals_refused(self, p: Probe, a: Route, rivals: list[Route], when: str) -> bool:
+        """Every conflicting route is refused while ``a`` is ``when``; a failure is replayed and recorded."""
+        for b in rivals:
+            if p.do(route_line(b)).ok:
+                self.replay_conflict(a, b, when)
+                return False
+            self.ctx.record(True, "conflict", f"{a.id} + {b.id}", "")
+        return True
 
     def replay_conflict(self, a: Route, b: Route, when: str) -> None:
         """``b`` was accepted with ``a`` set: record the failure with a script of just the two routes."""
