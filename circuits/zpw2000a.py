@@ -145,7 +145,7 @@ def capacitor_positions(station: Station, section_id: str, params: ZpwParams = D
         return []
     if caps.positions is not None:
         return sorted(caps.positions)
-    length = station.section_length(section_id)
+    length = station.section_span(section_id)
     if caps.count is not None:
         return standard_positions(length, caps.count, params)
     return standard_positions(length, None, params) if caps.rule == "standard" else []

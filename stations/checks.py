@@ -16,6 +16,7 @@ from .schema import (
     Direction,
     EndKind,
     Lamp,
+    LinkKind,
     SectionRole,
     SignalKind,
     StationFile,
@@ -53,6 +54,7 @@ class _Checker:
         self.signals()
         self.standalone_buttons()
         self.fouling_points()
+        self.diamonds()
         self.markers()
         self.platforms()
         self.links()
@@ -67,7 +69,7 @@ class _Checker:
             ("tracks", self.m.tracks, "track"), ("sections", self.m.sections, "section"),
             ("signals", self.m.signals, "button"), ("buttons", self.m.buttons, "button"),
             ("fouling_points", self.m.fouling_points, "fouling"), ("platforms", self.m.platforms, "platform"),
-            ("markers", self.m.markers, "marker"),
+            ("markers", self.m.markers, "marker"), ("diamonds", self.m.diamonds, "diamond"),
             ("links", self.m.links, "link"),
         ]
         seen: dict[tuple[str, str], str] = {}
@@ -332,6 +334,41 @@ class _Checker:
                          f"({min(xa, xb):g}-{max(xa, xb):g} m)",
                          "a fouling point lies on its track, between the track's two ends")
 
+    def diamonds(self) -> None:
+        tracks = {t.id: t for t in self.m.tracks}
+        for k, d in enumerate(self.m.diamonds):
+            bad = [m for m, tid in enumerate(d.tracks) if tid not in tracks]
+            for m in bad:
+                self.err(("diamonds", k, "tracks", m), f"diamond {d.id} names unknown track '{d.tracks[m]}'",
+                         "name the two tracks that cross, as listed under 'tracks:'")
+            if bad:
+                continue
+            a, b = (tracks[tid] for tid in d.tracks)
+            if a.id == b.id:
+                self.err(("diamonds", k, "tracks"), f"diamond {d.id} crosses track '{a.id}' with itself",
+                         "a diamond is two different tracks crossing")
+                continue
+            nodes_a = {parse_port(a.start).node, parse_port(a.end).node}
+            nodes_b = {parse_port(b.start).node, parse_port(b.end).node}
+            if nodes_a & nodes_b:
+                self.err(("diamonds", k, "tracks"), f"diamond {d.id}: tracks {a.id} and {b.id} meet at "
+                         f"'{sorted(nodes_a & nodes_b)[0]}', so they do not cross",
+                         "a diamond joins two tracks that cross without any node in common")
+                continue
+            spans = []
+            for t in (a, b):
+                xa = self.node_positions[parse_port(t.start).node]
+                xb = self.node_positions[parse_port(t.end).node]
+                spans.append((min(xa, xb), max(xa, xb)))
+            lo, hi = max(spans[0][0], spans[1][0]), min(spans[0][1], spans[1][1])
+            if lo > hi:
+                self.err(("diamonds", k, "tracks"), f"diamond {d.id}: tracks {a.id} ({spans[0][0]:g}-"
+                         f"{spans[0][1]:g} m) and {b.id} ({spans[1][0]:g}-{spans[1][1]:g} m) do not overlap along "
+                         "the line, so they cannot cross", "name two tracks that pass the same point")
+            elif d.at is not None and not lo <= d.at <= hi:
+                self.err(("diamonds", k, "at"), f"diamond {d.id} at {d.at:g} m is not on both tracks (they run "
+                         f"side by side from {lo:g} to {hi:g} m)", "give the point where the two tracks cross")
+
     def markers(self) -> None:
         tracks = {t.id: t for t in self.m.tracks}
         for k, mk in enumerate(self.m.markers):
@@ -365,6 +402,7 @@ class _Checker:
     def links(self) -> None:
         ends = {e.id: e for e in self.m.ends}
         sections = {s.id for s in self.m.sections}
+        roles_of = {s.id: s.role for s in self.m.sections}
         for k, lk in enumerate(self.m.links):
             e = ends.get(lk.end)
             if e is None or e.kind is not EndKind.boundary:
@@ -374,6 +412,15 @@ class _Checker:
                 if sec not in sections:
                     self.err(("links", k, "sections", m), f"link {lk.id}: section '{sec}' is not declared",
                              "name a section listed under 'sections:'")
+            if lk.bidirectional and lk.kind is not LinkKind.automatic:
+                self.err(("links", k, "bidirectional"), f"link {lk.id} is a {lk.kind.value} line; only automatic "
+                         "block lines have a running direction to change (改方)",
+                         "remove 'bidirectional', or make the line 'kind: automatic'")
+            roles = {roles_of[sec] for sec in lk.sections if sec in roles_of}
+            if lk.kind is LinkKind.automatic and roles >= {SectionRole.approach, SectionRole.departure}:
+                self.err(("links", k, "sections"), f"link {lk.id} mixes approach and departure sections, so its "
+                         "running direction is unclear", "an automatic line runs one way: list its approach "
+                         "sections (towards the station) or its departure sections (away from it)")
 
     def overlaps_and_overrides(self) -> None:
         signals = {s.id for s in self.m.signals}

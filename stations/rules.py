@@ -177,9 +177,10 @@ class _Warner:
             if s.type is CircuitType.phase25hz and length > self.r.phase25hz_max_length_m:
                 self.warn(self.loc("sections", s.id), f"25 Hz section '{s.id}' is {length:.0f} m long "
                           f"(limit about {self.r.phase25hz_max_length_m:g} m)", "split it with an insulated joint")
-            if (s.type is CircuitType.zpw2000a and length > self.r.capacitor_min_section_m
+            run = self.st.section_span(s.id)  # the track circuit's main run, not its branches added to it
+            if (s.type is CircuitType.zpw2000a and run > self.r.capacitor_min_section_m
                     and (s.capacitors is None or s.capacitors.count == 0)):
-                self.warn(self.loc("sections", s.id), f"ZPW-2000A section '{s.id}' is {length:.0f} m long but has no "
+                self.warn(self.loc("sections", s.id), f"ZPW-2000A section '{s.id}' is {run:.0f} m long but has no "
                           f"compensation capacitors (needed over {self.r.capacitor_min_section_m:g} m)",
                           "add 'capacitors: {rule: standard}'")
 

@@ -307,13 +307,30 @@ class LinkKind(StrEnum):
 
 
 class Link(Strict):
-    """A block link to a neighbour station (区间闭塞)."""
+    """A block link to a neighbour station (区间闭塞).
+
+    On an automatic block line the running direction follows from its sections: approach sections (``role:
+    approach``) carry trains towards the station, departure sections away from it. ``bidirectional: true`` says the
+    line may be worked the other way after a direction change (改方, 双向自动闭塞); a departure against the running
+    direction of a line that is not bidirectional is refused.
+    """
 
     id: Id
     kind: LinkKind
     end: Id  # the boundary end the link leaves from
     neighbour: Name
     sections: list[Id] = Field(default_factory=list)  # block/departure sections, nearest first
+    bidirectional: bool = False
+
+
+class Diamond(Strict):
+    """A diamond crossing (菱形交叉): two tracks that cross at grade, such as the two diagonals in the middle of a
+    scissors crossover (交叉渡线). No movement passes from one track to the other, but a movement on either
+    occupies the crossing, so two movements may never use both at once."""
+
+    id: Id
+    tracks: list[Id] = Field(min_length=2, max_length=2)
+    at: Position | None = None  # where the tracks cross (optional; checked against both tracks when given)
 
 
 class TurnoutPosition(StrEnum):
@@ -321,8 +338,23 @@ class TurnoutPosition(StrEnum):
     reverse = "reverse"
 
 
+_ROUTE_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_\-/]*(\([A-Za-z0-9_\-/,]+\))?(/D)?$")
+
+
+def _check_route_id(value: str) -> str:
+    if not _ROUTE_RE.match(value):
+        raise ValueError(f"'{value}' is not a route id: routes are named START-END, with the variant buttons in "
+                         "brackets (X-XI(BA1)); see 'liansuo table STATION'")
+    return value
+
+
+# A route of the interlocking table, as 'liansuo table' names it: START-END, START-END(VIA), START-END/D.
+RouteId = Annotated[str, AfterValidator(_check_route_id), WithJsonSchema({"type": "string",
+                                                                           "pattern": _ROUTE_RE.pattern})]
+
+
 class ProtectionOverride(Strict):
-    route: Id
+    route: RouteId
     turnout: Id
     position: TurnoutPosition
 
@@ -332,7 +364,7 @@ class Overrides(Strict):
 
     protection: list[ProtectionOverride] = Field(default_factory=list)
     remove_protection: list[ProtectionOverride] = Field(default_factory=list)
-    forbid: list[Id] = Field(default_factory=list)
+    forbid: list[RouteId] = Field(default_factory=list)
 
 
 class TurnoutAt(Strict):
@@ -368,6 +400,7 @@ class StationFile(Strict):
     signals: list[Signal] = Field(default_factory=list)
     buttons: list[StandaloneButton] = Field(default_factory=list)
     fouling_points: list[FoulingPoint] = Field(default_factory=list)
+    diamonds: list[Diamond] = Field(default_factory=list)
     markers: list[Marker] = Field(default_factory=list)
     platforms: list[Platform] = Field(default_factory=list)
     links: list[Link] = Field(default_factory=list)

@@ -73,6 +73,12 @@ class Station:
         self.sections: dict[str, Section] = {s.id: s for s in model.sections}
         self.signals: dict[str, Signal] = {s.id: s for s in model.signals}
         self.buttons: dict[str, StandaloneButton] = {b.id: b for b in model.buttons}
+        # track -> [(diamond, the track crossing it)]
+        self.crossings: dict[str, list[tuple[str, str]]] = {}
+        for d in model.diamonds:
+            one, two = d.tracks
+            self.crossings.setdefault(one, []).append((d.id, two))
+            self.crossings.setdefault(two, []).append((d.id, one))
         # track ends
         self.track_ports: dict[str, tuple[Port, Port]] = {
             t.id: (parse_port(t.start), parse_port(t.end)) for t in model.tracks
@@ -132,7 +138,14 @@ class Station:
         return b if self.node_at(a.node) <= self.node_at(b.node) else a
 
     def section_length(self, section: str) -> float:
+        """All the track of a section: a turnout section counts its main line and its branches."""
         return sum(self.track_length(t) for t in self.section_tracks[section])
+
+    def section_span(self, section: str) -> float:
+        """How far a section reaches along the line, from its lowest to its highest point: the length of a track
+        circuit's main run (a turnout section's branches lie beside it, not after it)."""
+        spans = [self.track_span(t) for t in self.section_tracks[section]]
+        return max(hi for _, hi in spans) - min(lo for lo, _ in spans)
 
     def joint_tracks(self, joint: str) -> tuple[str, str]:
         """(track on the low side, track on the high side) of a joint."""
@@ -203,6 +216,20 @@ class Station:
         for s in self.model.signals:
             out.setdefault(s.at, []).append(s)
         return out
+
+    def link_running(self, link: str) -> str | None:
+        """The running direction of an automatic block line: 'inbound' (towards the station, over approach
+        sections) or 'outbound' (departure sections); None for a line worked both ways by its block machines (64D)
+        or one whose sections do not say."""
+        lk = next(x for x in self.model.links if x.id == link)
+        if lk.kind.value != "automatic":
+            return None
+        roles = {self.sections[s].role for s in lk.sections if s in self.sections}
+        if SectionRole.approach in roles:
+            return "inbound"
+        if SectionRole.departure in roles:
+            return "outbound"
+        return None
 
     def is_station_track(self, section: str) -> bool:
         return self.sections[section].role is SectionRole.station_track
