@@ -65,6 +65,7 @@ class Field:
         self.cab_codes: dict[str, str | None] = {}
         self._driven: set[str] = set()  # machines with a drive command outstanding
         self._moving: set[str] = set()
+        self.stamp = 0  # counts the batches of changes taken: what reads the field can tell when nothing changed
         self._changes = Changes(set(station.sections), set(station.turnouts), set(station.signals),
                                 set(self.doors))
         for c in self.circuits.values():
@@ -126,8 +127,9 @@ class Field:
         for sig in cmd.changed_signals:
             self._relight(sig, cmd.lamps.get(sig, set()))
             fl = self.flashers.get(sig)
-            if fl is not None:
+            if fl is not None and fl.energised != (sig in cmd.flashing):
                 fl.energise(sig in cmd.flashing)
+                self._changes.signals.add(sig)
         cmd.changed_signals.clear()
         for sig, fl in self.flashers.items():
             if fl.energised:
@@ -186,9 +188,15 @@ class Field:
     def take_changes(self) -> Changes:
         out = self._changes
         self._changes = Changes()
+        if out.tracks or out.turnouts or out.signals or out.doors:
+            self.stamp += 1
         return out
 
     # ---- what a person at the lineside would see -----------------------------------------------------------------
+    def machines_running(self) -> set[str]:
+        """Turnouts whose switch machine motors are running now."""
+        return {t for t in self._moving if self.machines[t].running}
+
     def lit_lamps(self, signal: str) -> set[str]:
         """Lamps actually lit now, including the flashing lamp's phase."""
         lit = set(self.lamps[signal].lit())

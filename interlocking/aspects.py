@@ -15,7 +15,9 @@ from stations.station import Station
 from .rules import RuleSet, load_rules
 
 if TYPE_CHECKING:
-    from .table import Route
+    from collections.abc import Iterable
+
+    from .route import Route, RouteTurnout
 
 PROCEED_TRAIN = ("L", "LL", "LU", "U", "UU", "USU")
 STOP = ("H", "A")
@@ -38,22 +40,31 @@ def usu_allowed(station: Station, route: Route, rules: RuleSet) -> bool:
         station.turnouts[t].number >= rules.usu_min_turnout_number for t in reverse)
 
 
-def possible_aspects(station: Station, route: Route, rules: RuleSet | None = None) -> tuple[str, ...]:
-    """What the table lists: every proceed aspect the route's signal can show for it."""
+def onward_allows_usu(station: Station, turnouts: Iterable[RouteTurnout], rules: RuleSet) -> bool:
+    """The onward route (of the next signal) runs straight, or diverges over No. 18 or larger turnouts only (技规)."""
+    return all(station.turnouts[t.id].number >= rules.usu_min_turnout_number for t in turnouts
+               if t.role == "route" and t.position is TurnoutPosition.reverse)
+
+
+def possible_aspects(station: Station, route: Route, rules: RuleSet | None = None,
+                     onward: Iterable[Route] = ()) -> tuple[str, ...]:
+    """What the table lists: every proceed aspect the route's signal can show for it (``onward``: the train routes
+    from its end signal)."""
     rules = rules or load_rules()
     if route.kind == "shunt":
         return ("B",)
-    sig = station.signals[route.signal]
     diverging = any(t.role == "route" and t.position is TurnoutPosition.reverse for t in route.turnouts)
     if route.category == "departure":
         link = next((lk for lk in station.model.links if lk.id == route.exit_link), None)
         if link is not None and link.kind.value == "64d":
             return (rules.semi_auto_departure,)
+        if link is not None and station.link_running(link.id) == "inbound":
+            return ("L",)  # against the running direction, after 改方: the whole line is one block
         return ("L", "LU", "U")
     if diverging:
-        return ("UU", "USU") if usu_allowed(station, route, rules) else ("UU",)
-    if sig.kind is SignalKind.route:
-        return ("L", "LU", "U")
+        usu = usu_allowed(station, route, rules) and any(onward_allows_usu(station, o.turnouts, rules)
+                                                         for o in onward)
+        return ("UU", "USU") if usu else ("UU",)
     return ("L", "LU", "U")
 
 
@@ -63,7 +74,7 @@ def select_aspect(station: Station, route: Route, next_aspect: str, clear_blocks
 
     ``next_aspect``: the aspect of the signal at the end of the route ('' if none).
     ``clear_blocks``: clear automatic block sections ahead of a departure (None on 64D lines).
-    ``usu_ready``: the onward route is open and the flasher is healthy.
+    ``usu_ready``: the onward route is open, straight or over No. 18+ turnouts, and the flasher is healthy.
     """
     rules = rules or load_rules()
     if route.kind == "shunt":

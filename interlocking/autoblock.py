@@ -3,7 +3,7 @@ the signal aspects without operator action."""
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Collection, Iterable
 
 from stations.schema import SignalKind
 from stations.station import Station
@@ -22,6 +22,7 @@ class AutoBlock:
     def __init__(self, station: Station) -> None:
         topo = station.topology
         self.signals: list[tuple[str, tuple[str, ...], str | None]] = []
+        self.line: dict[str, str] = {}  # block signal -> the automatic line it stands on
         for sig in station.model.signals:
             if sig.kind is not SignalKind.block:
                 continue
@@ -42,16 +43,25 @@ class AutoBlock:
                     break
                 move = moves[0][0]
             self.signals.append((sig.id, tuple(sections), nxt_signal))
+            for lk in station.model.links:
+                if lk.kind.value == "automatic" and sections and sections[0] in lk.sections:
+                    self.line[sig.id] = lk.id
 
-    def update(self, out: Outputs, clear: Callable[[str], bool], proven: Callable[[str, str], str]) -> None:
-        """Evaluate the chain until it settles, so a change at one end reaches the other within the cycle."""
+    def update(self, out: Outputs, clear: Callable[[str], bool], proven: Callable[[str, str], str],
+               red_dark: Collection[str] = (), reversed_lines: Collection[str] = ()) -> None:
+        """Evaluate the chain until it settles, so a change at one end reaches the other within the cycle.
+
+        ``red_dark``: signals whose red lamp is dark: one of them at stop shows nothing, so the block signal in rear
+        of it shows H (红灯转移). ``reversed_lines``: lines whose direction is changed for departures from this station
+        (改方): their block signals, which face the other way, are held at H."""
         for _ in range(len(self.signals) + 1):
             changed = False
             for sig, sections, nxt in self.signals:
-                if any(not clear(s) for s in sections):
+                ahead = out.signals.get(nxt, "L") if nxt else "L"
+                if self.line.get(sig) in reversed_lines or any(not clear(s) for s in sections) or (
+                        nxt in red_dark and ahead in ("H", "")):
                     aspect = "H"
                 else:
-                    ahead = out.signals.get(nxt, "L") if nxt else "L"
                     aspect = _FOLLOW.get(ahead, "L")
                 shown = proven(sig, aspect) if aspect != "H" else "H"
                 if out.signals.get(sig) != shown:
@@ -71,7 +81,7 @@ def cab_codes(station: Station, rules: RuleSet, routes: Iterable[RouteState],
             continue
         governing = r.end_signal if r.end_signal else r.signal
         code = rules.cab_codes.get(aspects.get(governing, "H"))
-        for i, s in enumerate(r.sections):
+        for i, s in enumerate(rs.sections):
             if s in codes and not rs.released[i]:
                 codes[s] = code
     return codes

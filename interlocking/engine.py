@@ -3,7 +3,8 @@
 Each cycle reads the relay board (inputs that changed since the last cycle), advances the routes in progress, and
 writes turnout, signal, door, cab-code and line outputs. It never reads the wall clock (``cycle(t)`` is given the
 simulated time) and never sees trains: only track relays. Work per cycle is proportional to what is in progress
-(active routes, moving turnouts, changed inputs), not to the size of the station.
+(active routes, moving turnouts, changed inputs), not to the size of the station. Every lock is in the ledger
+(:mod:`.locks`).
 
 Evaluation order per cycle (as in one real CBI): inputs -> signal-passed-at-danger check against last cycle's
 aspects -> 64D line -> turnout supervision and the move queue -> routes in order of selection -> automatic block
@@ -14,25 +15,30 @@ from __future__ import annotations
 
 from collections import deque
 
-from stations.schema import SignalKind
+from stations.schema import SectionRole, SignalKind
 from stations.station import Station
 
-from .aspects import downgrade, is_open, select_aspect, stop_aspect
+from .aspects import downgrade, is_open, onward_allows_usu, select_aspect, stop_aspect
 from .autoblock import AutoBlock, cab_codes
 from .block64d import BlockLink, line_pulses_in, line_tracks_changed
 from .io import Alarm, DoorCommand, Event, Outputs, RelayBoard
+from .locks import Hold, LockLedger
+from .route import InterlockingTable, Route
 from .rules import RuleSet, load_rules
 from .state import RouteStage, RouteState, SignalState, TurnoutState
-from .table import InterlockingTable, Route
 
 MAX_EVENTS = 20_000
+# sections the interlocking locks at power-up (上电锁闭): all of the station's own, not the lines'
+INTERLOCKED = frozenset({SectionRole.throat, SectionRole.station_track, SectionRole.spur})
 
 
 class Engine:
     """One station's interlocking logic, driven by ``cycle(t)``; :class:`~interlocking.operations.Interlocking`
-    adds the operator commands."""
+    adds the operator commands. ``locked_at_start``: the state after power-up (上电): every section locked and every
+    signal closed until the operator's power-up release."""
 
-    def __init__(self, table: InterlockingTable, rules: RuleSet | None = None, cycle_s: float = 0.25) -> None:
+    def __init__(self, table: InterlockingTable, rules: RuleSet | None = None, cycle_s: float = 0.25, *,
+                 locked_at_start: bool = False) -> None:
         self.table = table
         self.station: Station = table.station
         self.rules = rules or load_rules()
@@ -43,9 +49,9 @@ class Engine:
         self.cycles = 0
         self.routes: dict[str, RouteState] = {}  # active routes in order of selection
         self.by_signal: dict[str, str] = {}
-        self.section_lock: dict[str, str] = {}  # section -> route id
-        self.overlap_pending: dict[str, tuple[tuple[str, ...], tuple[str, ...], float | None]] = {}
         st = self.station
+        self.locks = LockLedger(st.turnout_section, st.pairs)
+        self.overlap_pending: dict[str, float | None] = {}  # route -> when its overlap releases (after the route)
         self.turnouts = {t: TurnoutState(t, st.turnout_section[t], st.turnouts[t].trailable) for t in st.turnouts}
         self.signals = {s.id: SignalState(s.id, stop_aspect(st, s.id)) for s in st.model.signals}
         for sig in st.model.signals:
@@ -53,10 +59,10 @@ class Engine:
         self.links = {lk.id: BlockLink(lk.id, lk.sections[0] if lk.sections else "")
                       for lk in st.model.links if lk.kind.value == "64d"}
         self.auto_links = {lk.id: tuple(lk.sections) for lk in st.model.links if lk.kind.value == "automatic"}
+        self.line_out: set[str] = set()  # automatic lines whose direction is changed for our departures (改方)
         self.queue: deque[str] = deque()
         self.moving: set[str] = set()
         self.no_indication: set[str] = set(st.turnouts)  # fail-safe: nothing reported yet
-        self.guide_locked: set[str] = set()
         self.usu_failed: set[str] = set()  # flasher check failed while showing USU: UU until the route releases
         self.guide_only: dict[str, float] = {}  # guide aspect without a route (throat under guide total lock)
         self.guide_seen: dict[str, bool] = {}
@@ -70,8 +76,15 @@ class Engine:
                                for p in st.model.platforms if p.screen_doors}
         self.autoblock = AutoBlock(st)
         self.codes_dirty = True
+        self.blocks_dirty = False  # the automatic block signals must be evaluated again (a line's direction changed)
         for key in (k for keys in self.platform_doors.values() for k in keys):
             self.out.doors.setdefault(key, DoorCommand())
+        self.power_up_locked = locked_at_start
+        if locked_at_start:
+            for name, section in st.sections.items():
+                if section.role in INTERLOCKED:
+                    self.locks.lock_section(name, Hold.power_up)
+            self.event("power", "interlocking started: every section locked until the power-up release (上电解锁)")
 
     # ---- bookkeeping --------------------------------------------------------------------------------------------
     def event(self, kind: str, text: str) -> None:
@@ -123,8 +136,10 @@ class Engine:
             self._advance(rs)
         self._guide_only()
         self._overlaps()
-        if self.autoblock.signals and (tracks or commanded or self.out.changed_signals):
-            self.autoblock.update(self.out, self.clear, self._proven)
+        if self.autoblock.signals and (tracks or signals or commanded or self.out.changed_signals or self.blocks_dirty):
+            self.blocks_dirty = False
+            dark = {s for s, ss in self.signals.items() if ss.red_dark}
+            self.autoblock.update(self.out, self.clear, self._proven, dark, self.line_out)
         if self.codes_dirty or self.out.changed_signals:
             self.codes_dirty = False
             self.out.cab_codes = cab_codes(self.station, self.rules, self.routes.values(), self.out.signals)
@@ -161,6 +176,16 @@ class Engine:
     def _supervise_turnouts(self) -> None:
         for t_id in list(self.moving):
             ts = self.turnouts[t_id]
+            if not self.clear(ts.section) and self.board.indication(t_id) != ts.target:
+                # a movement entered the turnout's section during the move: stop driving it, so the machine is
+                # never started again under the movement (the turnout stays without indication: fail-safe)
+                self.moving.discard(t_id)
+                self.out.drive(t_id, None)
+                self.alarm(f"move:{t_id}", f"turnout {t_id}: drive to {ts.target} stopped, section {ts.section} "
+                           "became occupied during the move")
+                ts.target = None
+                ts.move_started = None
+                continue
             if ts.target is not None and self.board.indication(t_id) == ts.target:
                 self.moving.discard(t_id)
                 self.out.drive(t_id, None)
@@ -182,6 +207,11 @@ class Engine:
             if ts.target is None:
                 continue
             if self.board.indication(t_id) == ts.target:
+                ts.target = None
+                continue
+            if not self.clear(ts.section):
+                # a movement reached the turnout while its move waited in the queue: never drive under it
+                self.event("turnout", f"turnout {t_id} not moved to {ts.target}: section {ts.section} is occupied")
                 ts.target = None
                 continue
             self.moving.add(t_id)
@@ -217,12 +247,11 @@ class Engine:
 
     # ---- routes ---------------------------------------------------------------------------------------------
     def _advance(self, rs: RouteState) -> None:
-        r = rs.route
         if rs.stage is RouteStage.setting:
-            if all(self.board.indication(t.id) == t.position.value for t in r.all_turnouts):
+            if all(self.board.indication(t.id) == t.position.value for t in rs.all_turnouts):
                 rs.stage = RouteStage.locked
                 rs.since = self.now
-                self.event("route", f"route {r.id} locked")
+                self.event("route", f"route {rs.id} locked")
             else:
                 return
         if rs.stage is RouteStage.locked:
@@ -237,13 +266,13 @@ class Engine:
             self._keep_open(rs)
             return
         if rs.stage is RouteStage.time_release:
-            if any(not self.clear(s) for s in r.sections):
+            if any(not self.clear(s) for s in rs.sections):
                 rs.stage = RouteStage.in_use
                 rs.entered = True
                 rs.release_at = None
-                self.event("route", f"time release of {r.id} abandoned: its route is occupied")
+                self.event("route", f"time release of {rs.id} abandoned: its route is occupied")
             elif rs.release_at is not None and self.now >= rs.release_at:
-                self.event("route", f"route {r.id} released by manual time release")
+                self.event("route", f"route {rs.id} released by manual time release")
                 self.finish(rs, all_sections=True)
             return
         if rs.stage is RouteStage.in_use:
@@ -257,27 +286,32 @@ class Engine:
             return False
         return not (r.approach and all(self.clear(s) for s in r.approach))
 
+    def checked_sections(self, rs: RouteState) -> tuple[str, ...]:
+        """Every section that must be clear for the signal: route and run-on, fouling, overlap."""
+        r = rs.route
+        return rs.sections + tuple(f.section for f in r.fouling) + r.overlap_sections
+
     def open_blocker(self, rs: RouteState, *, guide: bool = False, sections: bool = True) -> str:
         """Why the signal of ``rs`` may not open (or stay open); '' when every condition holds. ``sections=False``
         excuses the occupied stretch of the route's sections from its first one on (a shunting consist passing its
         open signal occupies them), but no section beyond a clear one, nor the fouling and overlap sections."""
         r = rs.route
         if any(rs.released):
-            released = [s for i, s in enumerate(r.sections) if rs.released[i]]
+            released = [s for i, s in enumerate(rs.sections) if rs.released[i]]
             return f"section {released[0]} of route {r.id} has been released: the route is no longer locked"
-        for t in r.all_turnouts:
+        for t in rs.all_turnouts:
             ind = self.board.indication(t.id)
             if ind != t.position.value:
                 what = "has no indication" if ind is None else f"is {ind}"
                 return f"turnout {t.id} {what}, the route needs it {t.position.value}"
-            if t in r.turnouts and rs.id not in self.turnouts[t.id].locks:
+            if t in rs.turnouts and rs.id not in self.locks.holders(t.id):
                 return f"turnout {t.id} is not locked in route {r.id}"
         if not guide:
             skip = 0
             if not sections:
-                while skip < len(r.sections) and not self.clear(r.sections[skip]):
+                while skip < len(rs.sections) and not self.clear(rs.sections[skip]):
                     skip += 1
-            for s in r.all_sections[skip:]:
+            for s in self.checked_sections(rs)[skip:]:
                 if not self.clear(s):
                     return f"section {s} is occupied"
         blocker = self._liaison_blocker(r)
@@ -296,8 +330,12 @@ class Engine:
             link = self.links[r.exit_link]
             if link.state.value != "permitted":
                 return f"block line {link.id} has not been accepted by the neighbour station (64D: {link.state.value})"
-        if r.exit_link in self.auto_links and self._clear_blocks(r.exit_link) == 0:
-            return f"departure section {self.auto_links[r.exit_link][0]} is occupied"
+        if r.exit_link in self.auto_links:
+            why = self.against_running(r.exit_link)
+            if why:
+                return why
+            if self._clear_blocks(r.exit_link) == 0:
+                return f"departure section {self.auto_links[r.exit_link][0]} is occupied"
         for sec in self._door_sections(r):
             for key in self.platform_doors[sec]:
                 if not self.board.doors_safe(key):
@@ -305,6 +343,18 @@ class Engine:
         if r.end_signal is not None and self.signals[r.end_signal].red_dark:
             return f"the red lamp of {r.end_signal} is dark (红灯转移): {r.signal} must stay closed"
         return ""
+
+    def against_running(self, link: str) -> str:
+        """Why a departure onto automatic line ``link`` may not go: it runs towards this station and its direction
+        has not been changed (改方); '' when it may."""
+        if self.station.link_running(link) != "inbound" or link in self.line_out:
+            return ""
+        lk = next(x for x in self.station.model.links if x.id == link)
+        if not lk.bidirectional:
+            return (f"line {link} runs towards this station and is not bidirectional: no departure against its "
+                    "running direction")
+        return (f"line {link} runs towards this station: change its direction for departures first (改方, "
+                f"'line-direction {link} out')")
 
     def _door_sections(self, r: Route) -> list[str]:
         out = [s for s in r.sections if s in self.platform_doors]
@@ -316,8 +366,11 @@ class Engine:
         return out
 
     def _clear_blocks(self, link: str) -> int:
+        sections = self.auto_links[link]
+        if link in self.line_out:  # worked against its running direction: the whole line is one block
+            return 3 if all(self.clear(s) for s in sections) else 0
         n = 0
-        for s in self.auto_links[link][:3]:
+        for s in sections[:3]:
             if not self.clear(s):
                 break
             n += 1
@@ -333,9 +386,15 @@ class Engine:
         r = rs.route
         next_aspect = self.out.signals.get(r.end_signal, "") if r.end_signal else ""
         clear_blocks = self._clear_blocks(r.exit_link) if r.exit_link in self.auto_links else None
+        onward = self.route_of(r.end_signal) if r.end_signal else None
         usu_ready = (bool(r.end_signal) and is_open(next_aspect) and self.board.flasher_ok(r.signal)
-                     and r.signal not in self.usu_failed)
+                     and r.signal not in self.usu_failed and onward is not None
+                     and onward_allows_usu(self.station, onward.turnouts, self.rules))
         return select_aspect(self.station, r, next_aspect, clear_blocks, usu_ready, self.rules)
+
+    def route_of(self, signal: str) -> RouteState | None:
+        rid = self.by_signal.get(signal)
+        return self.routes.get(rid) if rid else None
 
     def _proven(self, signal: str, aspect: str) -> str:
         """The aspect after lamp proving: never more permissive than ``aspect``."""
@@ -406,8 +465,11 @@ class Engine:
             self.event("signal", f"signal {r.signal}: {before} -> {aspect}")
 
     def _keep_guide(self, rs: RouteState) -> None:
+        """The guide aspect HB closes when the guided train enters the first section inside the signal; when that
+        section is the faulty one (already showing occupied), once the train has passed the signal (its approach
+        clear again); unused, after the rule set's time."""
         r = rs.route
-        for t in r.all_turnouts:
+        for t in rs.all_turnouts:
             if self.board.indication(t.id) != t.position.value:
                 self.close_signal(rs, f"turnout {t.id} lost its indication", abnormal=True)
                 rs.guide = False
@@ -419,20 +481,33 @@ class Engine:
         approach_occupied = any(not self.clear(s) for s in r.approach)
         if approach_occupied:
             rs.guide_approach_seen = True
-        elif rs.guide_approach_seen:
-            self.close_signal(rs, "guided train has passed", abnormal=False)
+        entered = (rs.guide_first_clear and not self.clear(r.sections[0])) or (
+            not rs.guide_first_clear and rs.guide_approach_seen and not approach_occupied)
+        if entered:
+            self.close_signal(rs, f"guided train entered {r.sections[0]}", abnormal=False)
             rs.stage = RouteStage.in_use
             rs.entered = True
-        elif self.now - rs.since > self.rules.guide_close_s:
+        elif not rs.guide_approach_seen and self.now - rs.since > self.rules.guide_close_s:
             self.close_signal(rs, "guide aspect not used", abnormal=False)
             rs.guide = False
             rs.stage = RouteStage.locked
+
+    def beyond(self, rs: RouteState) -> str | None:
+        """The section just past the route (past its run-on, where it has one)."""
+        ro = rs.run_on
+        if ro is None:
+            return rs.route.beyond
+        if ro.leads_into is not None:
+            return ro.leads_into
+        if ro.end_node in self.station.joints:
+            return self.station.tracks[self.station.entry_track(ro.end_node, rs.route.direction)].section
+        return None
 
     def _sequential_release(self, rs: RouteState) -> None:
         """Normal release with the three-point check: a section releases when the one in rear has released, this
         one was occupied and is clear again, and the next one is occupied."""
         r = rs.route
-        secs = r.sections
+        secs = rs.sections
         n = len(secs)
         any_occupied = False
         for i, s in enumerate(secs):
@@ -440,6 +515,9 @@ class Engine:
                 rs.was_occupied[i] = True
                 any_occupied = True
         last = n - 1
+        # a shunting movement that drew back out of its route (中途返回): nothing in the route occupied, the section
+        # in rear of the signal occupied again; the sections it passed release without the next one occupied
+        drew_back = r.kind == "shunt" and not any_occupied and any(not self.clear(a) for a in r.approach)
         if (r.overlap_sections and not rs.released[last] and rs.was_occupied[last]
                 and rs.overlap_release_at is None):
             rs.overlap_release_at = self.now + r.overlap_release_s
@@ -455,11 +533,11 @@ class Engine:
                 continue
             if not rs.was_occupied[i] or not self.clear(s):
                 break
-            nxt = secs[i + 1] if i < last else r.beyond
-            if nxt is not None and self.clear(nxt) and not (r.kind == "shunt" and not any_occupied):
+            nxt = secs[i + 1] if i < last else self.beyond(rs)
+            if nxt is not None and self.clear(nxt) and not drew_back:
                 break  # the movement has not reached the next section
             self._release_section(rs, i)
-        if r.kind == "shunt" and not any_occupied and any(rs.released) and not all(rs.released):
+        if drew_back and any(rs.released) and not all(rs.released):
             # partial release: the shunting movement drew back out of the route
             for i in range(n):
                 if not rs.released[i]:
@@ -468,35 +546,26 @@ class Engine:
             self.finish(rs, all_sections=False)
 
     def _release_section(self, rs: RouteState, i: int) -> None:
-        s = rs.route.sections[i]
+        s = rs.sections[i]
         rs.released[i] = True
         self.codes_dirty = True
-        if self.section_lock.get(s) == rs.id:
-            del self.section_lock[s]
-        for t in rs.route.turnouts:
+        self.locks.unlock_section(s, Hold.route, rs.id)
+        for t in rs.turnouts:
             if self.station.turnout_section[t.id] == s:
-                self.turnouts[t.id].locks.discard(rs.id)
+                self.locks.unlock_turnout(t.id, Hold.route, rs.id)
         self.event("release", f"section {s} released ({rs.id})")
 
     def finish(self, rs: RouteState, *, all_sections: bool) -> None:
         """Release the whole route (what is still locked), keeping a running overlap timer."""
         r = rs.route
-        for i, s in enumerate(r.sections):
-            if not rs.released[i]:
-                rs.released[i] = True
-                if self.section_lock.get(s) == rs.id:
-                    del self.section_lock[s]
-        for f in r.fouling:
-            if self.section_lock.get(f.section) == rs.id:
-                del self.section_lock[f.section]
-        for t in r.turnouts:
-            self.turnouts[t.id].locks.discard(rs.id)
+        rs.released = [True] * len(rs.released)
+        self.locks.release(Hold.route, rs.id)
+        self.locks.release(Hold.fouling, rs.id)
         if r.overlap_sections:
             if rs.overlap_release_at is not None and not all_sections:
-                self.overlap_pending[rs.id] = (r.overlap_sections, tuple(t.id for t in r.overlap_turnouts),
-                                               rs.overlap_release_at)
+                self.overlap_pending[rs.id] = rs.overlap_release_at
             else:
-                self._release_overlap(rs.id, r.overlap_sections, tuple(t.id for t in r.overlap_turnouts))
+                self._release_overlap(rs.id)
         if self.out.signals.get(r.signal) != stop_aspect(self.station, r.signal):
             self.out.set_aspect(r.signal, stop_aspect(self.station, r.signal))
         self.signals[r.signal].route = None
@@ -508,19 +577,15 @@ class Engine:
         self.codes_dirty = True
         self.event("route", f"route {r.id} released")
 
-    def _release_overlap(self, rid: str, sections: tuple[str, ...], turnouts: tuple[str, ...]) -> None:
-        for s in sections:
-            if self.section_lock.get(s) == f"overlap:{rid}":
-                del self.section_lock[s]
-        for t in turnouts:
-            self.turnouts[t].locks.discard(f"overlap:{rid}")
+    def _release_overlap(self, rid: str) -> None:
+        self.overlap_pending.pop(rid, None)
+        self.locks.release(Hold.overlap, rid)
         self.event("release", f"overlap of {rid} released")
 
     def _overlaps(self) -> None:
-        for rid, (sections, turnouts, at) in list(self.overlap_pending.items()):
+        for rid, at in list(self.overlap_pending.items()):
             if at is not None and self.now >= at:
-                del self.overlap_pending[rid]
-                self._release_overlap(rid, sections, turnouts)
+                self._release_overlap(rid)
 
     def _guide_only(self) -> None:
         for sig, since in list(self.guide_only.items()):
@@ -528,8 +593,9 @@ class Engine:
             occupied = any(not self.clear(s) for s in approach)
             if occupied:
                 self.guide_seen[sig] = True
-            if (not occupied and self.guide_seen.get(sig)) or (not self.guide_seen.get(sig)
-                                                               and self.now - since > self.rules.guide_close_s):
+            entered = not self.clear(self.entry_section[sig])
+            if entered or (not occupied and self.guide_seen.get(sig)) or (
+                    not self.guide_seen.get(sig) and self.now - since > self.rules.guide_close_s):
                 del self.guide_only[sig]
                 self.guide_seen.pop(sig, None)
                 self.out.set_aspect(sig, stop_aspect(self.station, sig))
@@ -547,19 +613,19 @@ class Engine:
             for sig in self.signal_by_entry.get(sec, ()):
                 if is_open(self.out.signals.get(sig, "")):
                     continue
-                owner = self.section_lock.get(sec)
-                passing = self.routes.get(owner) if owner is not None and owner != self.by_signal.get(sig) else None
-                if passing is not None and (passing.route.direction is not self.station.signals[sig].direction
-                                            or self.station.signals[sig].at in passing.route.path.joints):
+                own = self.by_signal.get(sig)
+                passing = [self.routes[h] for h in self.locks.section_holders(sec, (Hold.route,))
+                           if h != own and h in self.routes]
+                if any(p.route.direction is not self.station.signals[sig].direction
+                       or self.station.signals[sig].at in p.route.path.joints for p in passing):
                     continue  # a movement from the other side, or one running past a signal inside its own route
                 rear = self.station.signal_rear_track(sig)
                 if rear is None or self.clear(self.station.tracks[rear].section):
                     continue
-                rid = self.by_signal.get(sig)
                 self.alarm(f"spad:{sig}:{self.now:.2f}", f"signal {sig} passed at danger (冒进信号): {sec} occupied "
                            "with the signal closed")
-                if rid is not None:
-                    rs = self.routes[rid]
+                if own is not None:
+                    rs = self.routes[own]
                     rs.entered = True
                     if rs.stage in (RouteStage.time_release, RouteStage.locked):
                         rs.stage = RouteStage.in_use

@@ -6,10 +6,11 @@ from __future__ import annotations
 from stations.schema import Button, SignalKind
 
 from .aspects import stop_aspect
-from .engine import Engine
+from .engine import INTERLOCKED, Engine
 from .io import Result
+from .locks import Hold
+from .route import Condition, Kind, Route, RunOn
 from .state import RouteStage, RouteState
-from .table import Kind, Route
 
 _KIND_WORD = {"train": "train", "shunt": "shunting"}
 
@@ -37,73 +38,126 @@ class Interlocking(Engine):
             return Result.refuse(f"no {_KIND_WORD[kind]} route from {start} to {end}"
                                  + (" via " + ",".join(via) if via else "")
                                  + (f"; routes from {start}: {', '.join(options)}" if options else ""))
-        why = self.route_blocker(r)
+        run_on, why = self.choose_run_on(r)
+        if not why:
+            why = self.route_blocker(r, run_on)
         if why:
             return Result.refuse(why)
-        rs = RouteState(r, RouteStage.setting, self.now)
+        rs = RouteState(r, RouteStage.setting, self.now, run_on=run_on)
         self.routes[r.id] = rs
         self.by_signal[r.signal] = r.id
-        for s in r.sections + tuple(f.section for f in r.fouling):
-            self.section_lock[s] = r.id
+        for s in rs.sections:
+            self.locks.lock_section(s, Hold.route, r.id)
+        for f in r.fouling:
+            self.locks.lock_section(f.section, Hold.fouling, r.id)
         for s in r.overlap_sections:
-            self.section_lock[s] = f"overlap:{r.id}"
-        for t in r.turnouts:
-            self.turnouts[t.id].locks.add(r.id)
+            self.locks.lock_section(s, Hold.overlap, r.id)
+        for t in rs.turnouts:
+            self.locks.lock_turnout(t.id, Hold.route, r.id)
         for t in r.overlap_turnouts:
-            self.turnouts[t.id].locks.add(f"overlap:{r.id}")
-        for t in r.all_turnouts:
+            self.locks.lock_turnout(t.id, Hold.overlap, r.id)
+        for t in rs.all_turnouts:
             if self.board.indication(t.id) != t.position.value:
                 self.request_move(t.id, t.position.value)
         self.codes_dirty = True
         self.event("route", f"route {r.id} selected")
         return Result.accept(f"route {r.id} selected")
 
-    def route_blocker(self, r: Route) -> str:
+    def choose_run_on(self, r: Route) -> tuple[RunOn | None, str]:
+        """The way a shunting movement runs on past the end of ``r``, as the turnouts beyond lie; or why it cannot
+        be told (a turnout beyond without indication)."""
+        if not r.run_on:
+            return None, ""
+        lies = {t: self.board.indication(t) for ro in r.run_on for t, _ in ro.when}
+        ro = r.run_on_for(lies)
+        if ro is not None:
+            return ro, ""
+        lost = sorted(t for t, pos in lies.items() if pos is None)
+        return None, (f"turnout {lost[0] if lost else '?'} beyond {r.end} has no indication: a shunting movement "
+                      f"running on past {r.end} could go either way")
+
+    def route_blocker(self, r: Route, run_on: RunOn | None = None) -> str:
+        """Why ``r`` (running on over ``run_on``) may not be set now; '' when it may."""
+        if self.power_up_locked:
+            return "the station is locked since the interlocking started (上电锁闭): give the power-up release first"
         if r.signal in self.by_signal:
             return f"signal {r.signal} already has route {self.by_signal[r.signal]} set"
-        for other, why in r.conflicts.items():
-            if other in self.routes and self._still_holds(self.routes[other], r):
+        if r.exit_link in self.auto_links:
+            why = self.against_running(r.exit_link)
+            if why:
+                return why
+        for other, rs in self.routes.items():
+            why = r.conflicts.get(other) or self._conditional(r, rs)
+            if why and self._still_conflicts(rs, r, run_on, why):
                 return f"conflicting route {other} is locked ({why})"
-        for s in r.all_sections:
-            owner = self.section_lock.get(s)
-            if owner is not None:
-                return f"section {s} is locked in route {owner.removeprefix('overlap:')}"
+        sections = list(r.sections) + (list(run_on.sections) if run_on else []) + list(r.overlap_sections)
+        for s in [*sections, *(f.section for f in r.fouling)]:
+            for lk in self.locks.section_locks(s):
+                if lk.hold is Hold.fouling and s not in sections:
+                    continue  # several routes may check the same fouling section
+                if lk.hold is Hold.overlap and lk.holder in self.routes and self._continues(lk.holder, r, s):
+                    continue  # the onward route of a through movement runs over the overlap
+                if lk.hold is Hold.power_up:
+                    return self.route_blocker_power_up(s)
+                return f"section {s} is locked {lk.words()}"
             if not self.clear(s):
                 return f"section {s} is occupied"
-        for t in r.all_turnouts:
-            ts = self.turnouts[t.id]
-            if ts.single_blocked:
+        turnouts = r.all_turnouts + (run_on.turnouts if run_on else ())
+        for t in turnouts:
+            if t.id in self.locks.blocked:
                 return f"turnout {t.id} is single-blocked (单封)"
             for member in self.pair_members(t.id):
-                ms = self.turnouts[member]
                 if self.board.indication(member) == t.position.value:
                     continue
-                if ms.single_locked:
-                    return f"turnout {member} is single-locked (单锁) and not {t.position.value}"
-                if ms.guide_locked:
-                    return f"turnout {member} is under guide total lock (引导总锁闭)"
-                if ms.locks:
-                    holder = sorted(ms.locks)[0].removeprefix("overlap:")
-                    return f"turnout {member} is locked in route {holder}"
-                if not self.clear(ms.section):
-                    return f"turnout {member} cannot move: section {ms.section} is occupied"
+                why = self.locks.why_turnout(member)
+                if why:
+                    return f"{why}; the route needs it {t.position.value}"
+                if not self.clear(self.turnouts[member].section):
+                    return f"turnout {member} cannot move: section {self.turnouts[member].section} is occupied"
         return ""
 
-    def _still_holds(self, rs: RouteState, r: Route) -> bool:
-        """Does the active route ``rs`` still lock something ``r`` needs? Sections released behind a train are free
-        for the next route, as in a real CBI, even while the rest of the train's route is still locked."""
-        wanted = set(r.all_sections)
-        held = {s for i, s in enumerate(rs.route.sections) if not rs.released[i]}
+    def route_blocker_power_up(self, section: str) -> str:
+        return f"section {section} is locked since the interlocking started (上电锁闭): give the power-up release first"
+
+    def _conditional(self, r: Route, rs: RouteState) -> str:
+        """The reason ``r`` conflicts with active route ``rs`` under the turnout positions as they are, if it does
+        only under some positions (a run-on past a signal of the other direction)."""
+        for cond, why in r.conditional.get(rs.id, ()):
+            if self._holds(cond):
+                return why
+        return ""
+
+    def _holds(self, cond: Condition) -> bool:
+        """The turnouts lie as ``cond`` says (or cannot be told: fail-safe, it holds)."""
+        return all(self.board.indication(t) in (p.value, None) for t, p in cond)
+
+    def _continues(self, rid: str, r: Route, section: str) -> bool:
+        """``r`` continues active route ``rid`` from its end signal in the same direction over its overlap."""
+        first = self.routes[rid].route
+        return (r.signal == first.end_signal and r.direction is first.direction
+                and section in first.overlap_sections and section not in first.sections)
+
+    def _still_conflicts(self, rs: RouteState, r: Route, run_on: RunOn | None, why: str) -> bool:
+        """Does the active route ``rs`` still hold something ``r`` needs? Sections released behind a train are free
+        for the next route, as in a real CBI, even while the rest of the train's route is still locked. An enemy
+        that leads head-on onto a track stays one while it holds (or leads into) that track."""
+        held = {s for i, s in enumerate(rs.sections) if not rs.released[i]}
+        track = r.head_on.get(rs.id)
+        if track is not None:
+            theirs = rs.run_on.leads_into if rs.run_on else rs.route.leads_into
+            if track in held or (theirs == track and bool(held)):
+                return True
+        wanted = set(r.all_sections) | (set(run_on.sections) if run_on else set())
         held |= {f.section for f in rs.route.fouling} | set(rs.route.overlap_sections)
         if wanted & held:
             return True
-        need = {t.id: t.position for t in r.all_turnouts}
-        return any(t.id in need and need[t.id] is not t.position and rs.id in self.turnouts[t.id].locks
-                   for t in rs.route.all_turnouts)
-
-    def route_of(self, signal: str) -> RouteState | None:
-        rid = self.by_signal.get(signal)
-        return self.routes.get(rid) if rid else None
+        need = {t.id: t.position for t in r.all_turnouts + (run_on.turnouts if run_on else ())}
+        if any(t.id in need and need[t.id] is not t.position and rs.id in self.locks.holders(t.id)
+               for t in rs.all_turnouts):
+            return True
+        crossings = self.station.crossings
+        return any(self.station.tracks[t].section in held for t in rs.route.path.tracks
+                   if any(d in r.diamonds for d, _ in crossings.get(t, ())))
 
     def approach_locked(self, rs: RouteState) -> bool:
         """接近锁闭: the signal has been open and a train is in the approach section."""
@@ -184,18 +238,21 @@ class Interlocking(Engine):
         if st.is_station_track(section):
             return Result.refuse(f"section {section} is a station track: section fault release is not allowed on "
                                  "a station track (股道)")
-        owner = self.section_lock.get(section)
-        if owner is None:
+        locks = self.locks.section_locks(section)
+        if any(lk.hold is Hold.power_up for lk in locks):
+            return Result.refuse(f"section {section} is locked since the interlocking started (上电锁闭): give the "
+                                 "power-up release")
+        routes = [lk.holder for lk in locks if lk.hold is Hold.route and lk.holder in self.routes]
+        overlaps = [lk.holder for lk in locks if lk.hold is Hold.overlap]
+        if not routes and not overlaps:
             return Result.refuse(f"section {section} is not locked")
         if not self.clear(section):
             return Result.refuse(f"section {section} is occupied: only a clear section can be released")
-        if owner.startswith("overlap:"):
-            rid = owner.removeprefix("overlap:")
-            r = self.table.routes[rid]
-            self.overlap_pending.pop(rid, None)
-            self._release_overlap(rid, r.overlap_sections, tuple(t.id for t in r.overlap_turnouts))
+        if not routes:
+            rid = overlaps[0]
+            self._release_overlap(rid)
             return Result.accept(f"overlap of {rid} released")
-        rs = self.routes[owner]
+        rs = self.routes[routes[0]]
         if rs.stage is RouteStage.open:
             return Result.refuse(f"signal {rs.route.signal} is open over {section}: close it first (cancel)")
         if self.approach_locked(rs) and not rs.entered:
@@ -204,11 +261,7 @@ class Interlocking(Engine):
             rs.release_at = self.now + delay
             self.event("route", f"section fault release of {section} with a train approaching: {delay:g} s")
             return Result.accept(f"section {section} ({rs.id}) releases in {delay:g} s unless a train enters")
-        if section in rs.route.sections:
-            i = rs.route.sections.index(section)
-            self._release_section(rs, i)
-        else:
-            del self.section_lock[section]
+        self._release_section(rs, rs.sections.index(section))
         self.event("release", f"section {section} released by section fault release")
         if all(rs.released):
             self.finish(rs, all_sections=False)
@@ -249,15 +302,17 @@ class Interlocking(Engine):
             if rs.stage not in (RouteStage.locked, RouteStage.setting) or rs.entered:
                 return Result.refuse(f"route {rs.id} is {rs.stage.value}; a guide route needs a locked route "
                                      "whose signal is closed")
-            released = [s for i, s in enumerate(rs.route.sections) if rs.released[i]]
+            released = [s for i, s in enumerate(rs.sections) if rs.released[i]]
             if released:  # e.g. by section fault release: its turnouts are no longer locked
                 return Result.refuse(f"guide refused: section {released[0]} of route {rs.id} has been released; "
                                      "cancel the route and set it again")
             blocker = self.open_blocker(rs, guide=True)
-            if blocker.startswith("turnout") or blocker.startswith("block") or blocker.startswith("screen"):
+            if blocker.startswith(("turnout", "block", "screen", "line")):
                 return Result.refuse(f"guide refused: {blocker}")
             rs.stage = RouteStage.open
             rs.guide = True
+            rs.guide_first_clear = self.clear(rs.route.sections[0])
+            rs.guide_approach_seen = False
             rs.opened_once = True
             rs.since = self.now
             rs.needs_reopen = False
@@ -268,7 +323,7 @@ class Interlocking(Engine):
             self.event("signal", f"guide aspect HB on {signal} (route {rs.id})")
             return Result.accept(f"guide aspect HB on {signal}")
         throat = next((name for name, turnouts in self.table.throats.items()
-                       if name == signal and set(turnouts) <= self.guide_locked), None)
+                       if name == signal and all(self._guide_locked(t, name) for t in turnouts)), None)
         if throat is None:
             return Result.refuse(f"no route is set from {signal} and its throat is not under guide total lock: "
                                  f"set the route first, or 'guide-lock {signal}'")
@@ -276,6 +331,9 @@ class Interlocking(Engine):
         self.out.set_aspect(signal, "HB")
         self.event("signal", f"guide aspect HB on {signal} under guide total lock")
         return Result.accept(f"guide aspect HB on {signal} (guide total lock)")
+
+    def _guide_locked(self, turnout: str, throat: str) -> bool:
+        return any(lk.hold is Hold.guide and lk.holder == throat for lk, _, _ in self.locks.turnout_locks(turnout))
 
     def guide_lock(self, throat: str, lock: bool) -> Result:
         """引导总锁闭: lock (or unlock) every turnout of a throat."""
@@ -286,11 +344,10 @@ class Interlocking(Engine):
         if not lock and throat in self.guide_only:
             return Result.refuse(f"the guide aspect of {throat} is open: cancel it before unlocking the throat")
         for t in turnouts:
-            self.turnouts[t].guide_locked = lock
             if lock:
-                self.guide_locked.add(t)
+                self.locks.lock_turnout(t, Hold.guide, throat)
             else:
-                self.guide_locked.discard(t)
+                self.locks.unlock_turnout(t, Hold.guide, throat)
         word = "locked" if lock else "unlocked"
         self.event("turnout", f"guide total lock: throat {throat} {word} ({', '.join(turnouts)})")
         return Result.accept(f"throat {throat} {word}: turnouts {', '.join(turnouts)}")
@@ -313,37 +370,94 @@ class Interlocking(Engine):
         if all(self.board.indication(t) == position for t in ids):
             return Result.accept(f"turnout {name} is already {position}")
         for t in ids:
-            ts = self.turnouts[t]
-            if ts.single_locked:
-                return Result.refuse(f"turnout {t} is single-locked (单锁): unlock it first")
-            if ts.locks:
-                holder = sorted(ts.locks)[0].removeprefix("overlap:")
-                return Result.refuse(f"turnout {t} is locked in route {holder}")
-            if ts.guide_locked:
-                return Result.refuse(f"turnout {t} is under guide total lock (引导总锁闭)")
-            if not self.clear(ts.section):
-                return Result.refuse(f"turnout {t} cannot move: section {ts.section} is occupied")
+            why = self.locks.why_turnout(t)
+            if why:
+                return Result.refuse(why)
+            if not self.clear(self.turnouts[t].section):
+                return Result.refuse(f"turnout {t} cannot move: section {self.turnouts[t].section} is occupied")
         self.request_move(ids[0], position)
         self.event("turnout", f"turnout {name} to {position} (individual operation)")
         return Result.accept(f"turnout {name} moving to {position}")
 
     def single_lock(self, name: str, on: bool) -> Result:
         """单锁 / 单解: the turnout (and its crossover partner) may not be moved."""
-        return self._turnout_flag(name, "single_locked", on, ("single-locked (单锁)", "unlocked (单解)"))
-
-    def single_block(self, name: str, on: bool) -> Result:
-        """单封 / 解封: no route through the turnout; individual operation stays allowed."""
-        return self._turnout_flag(name, "single_blocked", on, ("single-blocked (单封)", "unblocked (解封)"))
-
-    def _turnout_flag(self, name: str, flag: str, on: bool, words: tuple[str, str]) -> Result:
         ids = self._turnout_ids(name)
         if ids is None:
             return Result.refuse(f"there is no turnout '{name}' at {self.station.id}")
         for t in ids:
-            setattr(self.turnouts[t], flag, on)
-        word = words[0] if on else words[1]
+            if on:
+                self.locks.lock_turnout(t, Hold.single)
+            else:
+                self.locks.unlock_turnout(t, Hold.single)
+        word = "single-locked (单锁)" if on else "unlocked (单解)"
         self.event("turnout", f"turnout {name} {word}")
         return Result.accept(f"turnout {name} {word}")
+
+    def single_block(self, name: str, on: bool) -> Result:
+        """单封 / 解封: no route through the turnout; individual operation stays allowed."""
+        ids = self._turnout_ids(name)
+        if ids is None:
+            return Result.refuse(f"there is no turnout '{name}' at {self.station.id}")
+        for t in ids:
+            if on:
+                self.locks.blocked.add(t)
+            else:
+                self.locks.blocked.discard(t)
+        word = "single-blocked (单封)" if on else "unblocked (解封)"
+        self.event("turnout", f"turnout {name} {word}")
+        return Result.accept(f"turnout {name} {word}")
+
+    # ---- power-up, line direction ----------------------------------------------------------------------------
+    def power_up_release(self) -> Result:
+        """上电解锁 (a sealed button): give back the sections locked since the interlocking started; refused while a
+        section of the station shows occupied."""
+        if not self.power_up_locked:
+            return Result.refuse("there is no power-up lock to release: the interlocking is in service")
+        occupied = [s for s, sec in self.station.sections.items() if sec.role in INTERLOCKED and not self.clear(s)]
+        if occupied:
+            return Result.refuse(f"power-up release refused: section {', '.join(occupied[:6])}"
+                                 f"{' ...' if len(occupied) > 6 else ''} shows occupied; every section of the station "
+                                 "must be clear (confirm on site, then use fault-release after the power-up release)")
+        self.locks.release_all(Hold.power_up)
+        self.power_up_locked = False
+        self.event("power", "power-up release (上电解锁): every section released")
+        return Result.accept("power-up release: the station is in service")
+
+    def line_direction(self, link: str, direction: str) -> Result:
+        """改方: set an automatic line for departures from this station ('out') or back to its running direction
+        ('in'). Only a bidirectional line, clear, with no route into or out of it."""
+        lk = next((x for x in self.station.model.links if x.id == link), None)
+        if lk is None or lk.kind.value != "automatic":
+            names = ", ".join(x.id for x in self.station.model.links if x.kind.value == "automatic") or "none"
+            return Result.refuse(f"there is no automatic block line '{link}' (automatic lines: {names})")
+        if direction not in ("out", "in"):
+            return Result.refuse("line-direction LINE out|in")
+        if self.station.link_running(link) != "inbound":
+            return Result.refuse(f"line {link} already runs away from this station: its direction needs no change")
+        if not lk.bidirectional:
+            return Result.refuse(f"line {link} is not bidirectional (双向): its direction cannot be changed")
+        want_out = direction == "out"
+        if (link in self.line_out) == want_out:
+            return Result.accept(f"line {link} is already set {'for departures' if want_out else 'towards us'}")
+        occupied = [s for s in lk.sections if not self.clear(s)]
+        if occupied:
+            return Result.refuse(f"line {link} is not clear ({', '.join(occupied)} occupied): the direction changes "
+                                 "only with the whole line clear")
+        for rs in self.routes.values():
+            r = rs.route
+            if r.exit_link == link or set(r.approach) & set(lk.sections):
+                return Result.refuse(f"route {r.id} uses line {link}: the direction changes only with no route "
+                                     "into or out of it")
+        if want_out:
+            self.line_out.add(link)
+            self.out.line_direction[link] = "outbound"
+        else:
+            self.line_out.discard(link)
+            self.out.line_direction.pop(link, None)
+        self.codes_dirty = self.blocks_dirty = True
+        word = "set for departures from this station" if want_out else "back to its running direction"
+        self.event("block", f"line {link} {word} (改方)")
+        return Result.accept(f"line {link} {word}")
 
     # ---- 64D block and platform doors ------------------------------------------------------------------------
     def block_line(self, link: str, action: str) -> Result:

@@ -36,6 +36,9 @@ USAGE = {
     "block": "block TURNOUT",
     "unblock": "unblock TURNOUT",
     "block-line": "block-line LINK request|accept|cancel|restore|accident",
+    "line-direction": "line-direction LINK out|in",
+    "power-up-release": "power-up-release",
+    "restart": "restart",
     "neighbour": "neighbour LINK request|depart|restore|accident",
     "doors": "doors PLATFORM open|close",
     "fault": "fault KIND TARGET [key=value ...]",
@@ -181,6 +184,24 @@ def _block_line(sim: Simulation, args: list[str]) -> Result:
     return sim.interlocking.block_line(args[0], args[1])
 
 
+def _line_direction(sim: Simulation, args: list[str]) -> Result:
+    if len(args) != 2:
+        return Result.refuse(f"usage: {USAGE['line-direction']}")
+    return sim.interlocking.line_direction(args[0], args[1])
+
+
+def _power_up_release(sim: Simulation, args: list[str]) -> Result:
+    if args:
+        return Result.refuse(f"usage: {USAGE['power-up-release']}")
+    return sim.interlocking.power_up_release()
+
+
+def _restart(sim: Simulation, args: list[str]) -> Result:
+    if args:
+        return Result.refuse(f"usage: {USAGE['restart']}")
+    return sim.restart_interlocking()
+
+
 def _neighbour(sim: Simulation, args: list[str]) -> Result:
     if len(args) != 2:
         return Result.refuse(f"usage: {USAGE['neighbour']}")
@@ -292,6 +313,9 @@ COMMANDS: dict[str, Handler] = {
     "block": _one("block", lambda s, a: s.interlocking.single_block(a, True)),
     "unblock": _one("unblock", lambda s, a: s.interlocking.single_block(a, False)),
     "block-line": _block_line,
+    "line-direction": _line_direction,
+    "power-up-release": _power_up_release,
+    "restart": _restart,
     "neighbour": _neighbour,
     "doors": _doors,
     "fault": _fault,

@@ -19,6 +19,7 @@ class Neighbour:
     auto: bool = True
     outbox: list[tuple[float, str]] = field(default_factory=list)  # (send at, pulse)
     our_train_out: bool = False
+    accepted: bool = False  # it has accepted our train and the train has not left yet (its block machine's view)
 
 
 class Neighbours:
@@ -31,6 +32,11 @@ class Neighbours:
     def send(self, link: str, pulse: str) -> None:
         self.by_link[link].outbox.append((self.t, pulse))
 
+    def permits(self, link: str) -> bool:
+        """The neighbour has accepted our train on ``link`` and it has not departed yet."""
+        nb = self.by_link.get(link)
+        return nb is not None and nb.accepted
+
     def step(self, t: float, line_out: dict[str, set[str]], clear: Callable[[str], bool]) -> None:
         self.t = t
         for link, pulses in line_out.items():
@@ -42,6 +48,10 @@ class Neighbours:
                     nb.outbox.append((t + self.pulse_s, "accept"))
                 elif p == "depart":
                     nb.our_train_out = True
+                    nb.accepted = False
+                elif p in ("restore", "accident"):
+                    nb.accepted = False
+                    nb.outbox = [(at, q) for at, q in nb.outbox if q != "accept"]
         line_out.clear()
         for link, nb in self.by_link.items():
             if nb.our_train_out and nb.auto and clear(self.section[link]):
@@ -55,3 +65,7 @@ class Neighbours:
                 nb.outbox = [(at, p) for at, p in nb.outbox if at > self.t]
                 for p in due:
                     board.pulse(link, p)
+                    if p == "accept":
+                        nb.accepted = True
+                    elif p in ("restore", "accident", "request"):
+                        nb.accepted = False

@@ -13,6 +13,7 @@ from pathlib import Path
 from circuits.field import Field
 from circuits.railgeometry import Axle
 from interlocking.io import Event, Result
+from interlocking.locks import Hold
 from interlocking.operations import Interlocking
 from interlocking.rules import RuleSet, load_rules
 from interlocking.state import RouteStage
@@ -47,7 +48,7 @@ class Simulation:
         ``sumo`` extra; see docs/sumo.md), or a :class:`~simulation.trains.engine.MotionEngine`."""
         self.station = station if isinstance(station, Station) else load(station)
         self.rules = load_rules(rules) if isinstance(rules, str) else rules
-        self.table = table or build_table(self.station)
+        self.table = table or build_table(self.station, self.rules)
         self.cycle_s = cycle_s
         self.interlocking: Interlocking = Interlocking(self.table, self.rules, cycle_s)
         self.field: Field = Field(self.station)
@@ -82,6 +83,20 @@ class Simulation:
         """Relays follow the field at once; only the interlocking's processing is cyclic."""
         self.wiring.publish(self.interlocking.board)
         self.neighbours.publish(self.interlocking.board)
+
+    def restart_interlocking(self) -> Result:
+        """The interlocking loses power and starts again (全站停电恢复): every route and lock is forgotten, every signal
+        closes, and the station stays locked (上电锁闭) until the operator's power-up release. The field keeps what
+        it had: turnouts lie where they lay, trains stay where they are."""
+        self.interlocking = Interlocking(self.table, self.rules, self.cycle_s, locked_at_start=True)
+        self.interlocking.now = self.t
+        self.wiring.relight()
+        self.wiring.publish(self.interlocking.board, everything=True)
+        self.neighbours.publish(self.interlocking.board)
+        self.interlocking.cycle(self.t)
+        self.log("power", "interlocking restarted: the station is locked until the power-up release (上电解锁)")
+        return Result.accept("interlocking restarted: every section locked and every signal closed until "
+                             "'power-up-release' (上电解锁)")
 
     def place_axles(self, name: str, axles: list[Axle]) -> None:
         """Stand a named set of wheelsets on the track (replacing that name's earlier ones; [] removes them)."""
@@ -150,14 +165,27 @@ class Simulation:
     def section_state(self, section: str) -> str:
         if not self.interlocking.board.clear(section):
             return "occupied"
-        if section in self.interlocking.section_lock:
+        if self.interlocking.locks.section_locked(section):
             return "locked"
         return "free"
 
     def turnout_state(self, turnout: str) -> tuple[str | None, bool]:
-        ts = self.interlocking.turnouts[turnout]
-        locked = bool(ts.locks) or ts.single_locked or ts.guide_locked
-        return self.interlocking.board.indication(turnout), locked
+        """(position indicated or None, locked): locked by a route, an overlap, single lock, guide total lock or the
+        power-up lock, or standing in a locked section."""
+        il = self.interlocking
+        return il.board.indication(turnout), il.locks.turnout_locked(turnout)
+
+    def turnout_mark(self, turnout: str) -> str:
+        """What the console marks on a turnout: 'blocked' (单封), 'locked' (单锁), 'guide' (引导总锁闭) or ''."""
+        locks = self.interlocking.locks
+        if turnout in locks.blocked:
+            return "blocked"
+        holds = {lk.hold for lk, _, _ in locks.turnout_locks(turnout)}
+        return "locked" if Hold.single in holds else "guide" if Hold.guide in holds else ""
+
+    def line_outbound(self, link: str) -> bool:
+        """The direction circuit of an automatic line is set for our departures (改方)."""
+        return self.interlocking.out.line_direction.get(link) == "outbound"
 
     def train_views(self) -> list[TrainView]:
         """Every train in the yard."""

@@ -21,6 +21,10 @@ class Wiring:
         self.signal_lamps = {s.id: {lamp.value for lamp in s.lamps} for s in station.model.signals}
         self._lit = False  # the first commands light every signal's lamps (the aspects set before any cycle)
 
+    def relight(self) -> None:
+        """Send every signal's lamps again with the next commands (a new interlocking has taken over)."""
+        self._lit = False
+
     def commands_from(self, out: Outputs) -> FieldCommands:
         cmd = self.commands
         cmd.drives = out.turnouts

@@ -57,17 +57,24 @@ def test_red_lamp_transfer_keeps_the_signal_in_rear_closed(jiaopei: Driver) -> N
 
 # ---- table ------------------------------------------------------------------------------------------------------
 @pytest.mark.parametrize("name", sorted(bundled()))
-def test_conflicts_are_complete_and_symmetric(name: str) -> None:
-    table = build_table(load(name))
+def test_conflicts_are_symmetric_and_agree_with_the_oracle(name: str) -> None:
+    """Every pair the oracle keeps apart (judged from the geometry, not from the table) is listed as conflicting,
+    and no other pair is; conflicts are listed on both routes."""
+    from proving.oracle.pairs import PaperOracle
+    from proving.verify.against import spec
+
+    st = load(name)
+    table = build_table(st)
+    oracle = PaperOracle(st, RULES)
     routes = list(table.routes.values())
     assert routes
     for a, b in itertools.combinations(routes, 2):
-        share = set(a.all_sections) & set(b.all_sections)
-        pa = {t.id: t.position for t in a.all_turnouts}
-        opposite = any(pa.get(t.id) not in (None, t.position) for t in b.all_turnouts)
-        must = bool(share) or opposite
-        assert (b.id in a.conflicts) == must, (a.id, b.id, share, opposite)
-        assert (a.id in b.conflicts) == (b.id in a.conflicts)
+        assert (a.id in b.conflicts) == (b.id in a.conflicts) and (a.id in b.conditional) == (b.id in a.conditional)
+        if a.signal == b.signal:
+            continue
+        apart = oracle.apart(spec(a), spec(b))
+        listed = b.id in a.conflicts or b.id in a.conditional
+        assert bool(apart) == listed, (a.id, b.id, apart, a.conflicts.get(b.id))
 
 
 def test_jiaopei_table_rows_a_signal_engineer_expects() -> None:
@@ -75,7 +82,7 @@ def test_jiaopei_table_rows_a_signal_engineer_expects() -> None:
     r = table.routes["X-XI"]
     assert r.category == "receiving" and r.sections == ("7DG", "1DG", "IG") and r.approach == ("IAG",)
     assert {(t.id, t.position.value, t.role) for t in r.turnouts} == {
-        ("7", "normal", "route"), ("1", "normal", "route"), ("3", "normal", "protection")}
+        ("7", "normal", "route"), ("1", "normal", "route"), ("3", "normal", "driven")}  # 3 moves with 1 (1/3)
     assert r.aspects == ("L", "LU", "U")
     assert table.routes["X-X3"].aspects == ("UU",)  # No. 12 turnouts: no USU
     assert table.routes["XI-S"].category == "departure" and table.routes["XI-S"].exit_link == "SL"
@@ -117,12 +124,15 @@ def test_table_command_formats(fmt: str, capsys: pytest.CaptureFixture[str]) -> 
         row = next(r for r in data["routes"] if r["id"] == "X-XI")
         assert {"id", "kind", "start", "end", "via", "signal", "turnouts", "sections", "approach",
                 "conflicts"} <= set(row)
-        assert row["kind"] == "train" and {"id": "3", "position": "normal", "role": "protection"} in row["turnouts"]
+        assert row["kind"] == "train" and {"id": "3", "position": "normal", "role": "driven"} in row["turnouts"]
+        assert row["exit_link"] is None and row["leads_into"] is None
+        d2xi = next(r for r in data["routes"] if r["id"] == "D2-XI")
+        assert d2xi["leads_into"] == "IG" and "X-XI" in d2xi["conflicts"]
     elif fmt == "csv":
         assert out.splitlines()[0].startswith("id,kind,category")
         assert any(line.startswith("X-XI,train,receiving") for line in out.splitlines())
     else:
-        assert "联锁表" in out and "X-XI" in out and "[3]" in out
+        assert "联锁表" in out and "X-XI" in out and "{3}" in out
 
 
 def test_variant_route_by_via_button_takes_the_detour(capsys: pytest.CaptureFixture[str]) -> None:
@@ -132,8 +142,11 @@ def test_variant_route_by_via_button_takes_the_detour(capsys: pytest.CaptureFixt
     v = table.routes["X-XI(BA1)"]
     assert v.via == ("BA1",) and "11-13DG" in v.sections and v.aspects == ("UU",)
     assert "X-XI" in v.conflicts  # same start signal, shared sections
-    # a scissors diagonal is never used as flank protection for a route over the other diagonal
-    assert not any(t.id in ("5", "7") and t.role == "protection" for t in v.turnouts)
+    # a route over one diagonal of the scissors keeps the other pair normal: with both pairs reverse the diagonals
+    # meet at the diamond
+    assert v.diamonds == ("XD1",)
+    assert {(t.id, t.position.value) for t in v.turnouts if t.role == "protection"} >= {("5", "normal"),
+                                                                                          ("7", "normal")}
     d = Driver(Simulation("gaotie"))
     d("route X BA1 XI", "run 15s", "expect turnout 13 reverse locked", "expect turnout 1 reverse locked",
       "expect signal X UU", "expect route X-XI(BA1) open")

@@ -147,5 +147,8 @@ def test_route_over_sections_released_behind_a_train_can_be_set_before_the_train
         jiaopei: Driver) -> None:
     jiaopei("route X XI", "run 1s", "occupy IAG", "occupy 7DG", "run 1s", "vacate IAG", "occupy 1DG", "run 1s",
             "vacate 7DG", "run 1s", "expect section 7DG free", "expect route X XI locked")
-    jiaopei("shunt D1 D3", "run 5s", "expect signal D1 B")  # 7DG only: released behind the train
-    jiaopei.refused("shunt D3 D1", "conflicting route D1-D3")  # the shunting route now holds 7DG
+    jiaopei("shunt D3 D1", "run 5s", "expect signal D3 B")  # 7DG only (and on into the neck): released behind the train
+    jiaopei.refused("shunt D1 D3", "conflicting route")  # the shunting route now holds 7DG
+    # a shunting movement from D1 to D3 would run on past D3 into 1DG, where the train still is
+    jiaopei("release D3", "run 31s")  # the train in 1DG approach-locks D3: manual time release, 30 s for shunting
+    jiaopei.refused("shunt D1 D3", "section 1DG")

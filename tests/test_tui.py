@@ -173,7 +173,7 @@ async def test_turnout_menu_single_lock_shows_the_red_mark_and_individual_operat
         assert isinstance(app.screen, MenuScreen)
         await pilot.click("#m-lock")
         await pilot.pause()
-        assert app.sim.interlocking.turnouts["5"].single_locked
+        assert app.sim.turnout_mark("5") == "locked"
         assert turnout_label(app, "5", "tmark") == ("■", "#ff2020")
         await pilot.press("v")  # 总反位
         await click(pilot, Ref("turnout", "5"))

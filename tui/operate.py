@@ -136,7 +136,7 @@ class Operator:
         template = mode.template
         if mode.name == "guide-lock":
             turnouts = self.sim.table.throats.get(target, ())
-            if turnouts and all(self.sim.interlocking.turnouts[t].guide_locked for t in turnouts):
+            if turnouts and all(self.sim.turnout_mark(t) == "guide" for t in turnouts):
                 template = "guide-unlock {}"
         command = template.format(target)
         question = f"{mode.zh} ({mode.en}): {command}?" if mode.confirm else ""

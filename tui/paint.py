@@ -67,9 +67,8 @@ def read_frame(sim: Simulation, lay: Layout) -> Frame:
     st = sim.station
     sections = {s: sim.section_state(s) for s in st.sections}
     turnouts: dict[str, tuple[str | None, str]] = {}
-    for t, ts in il.turnouts.items():
-        mark = "blocked" if ts.single_blocked else "locked" if ts.single_locked else "guide" if ts.guide_locked else ""
-        turnouts[t] = (il.board.indication(t), mark)
+    for t in il.turnouts:
+        turnouts[t] = (il.board.indication(t), sim.turnout_mark(t))
     lamps: dict[str, list[tuple[str, bool]]] = {}
     for sig in st.model.signals:
         have = [lamp.value for lamp in sig.lamps]

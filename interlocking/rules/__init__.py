@@ -4,11 +4,21 @@ from __future__ import annotations
 
 from functools import cache
 from pathlib import Path
+from typing import Literal
 
 import yaml
 from pydantic import BaseModel, ConfigDict
 
 HERE = Path(__file__).parent
+
+
+class ApproachLocking(BaseModel):
+    """How far in rear of a signal its approach (接近区段) reaches."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+    home: dict[str, int]  # line kind in rear (automatic, 64d, none) -> block sections
+    other: int  # track sections in rear of every other signal
 
 
 class RuleSet(BaseModel):
@@ -32,6 +42,8 @@ class RuleSet(BaseModel):
     lamps: dict[str, list[str]]
     cab_codes: dict[str, str | None]
     semi_auto_departure: str
+    approach_locking: ApproachLocking
+    enemy_onto_track: list[tuple[Literal["train", "shunt"], Literal["train", "shunt"]]]
 
 
 @cache

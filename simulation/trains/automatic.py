@@ -69,7 +69,7 @@ def inputs_for(sim: Simulation, tr: Train, ctl: AutoController) -> ShuntingInput
     locked = rs is not None and rs.stage in (RouteStage.locked, RouteStage.open, RouteStage.in_use)
     front_track, _ = sim.fleet.front(tr)
     front_section = sim.station.tracks[front_track].section if front_track in sim.station.tracks else ""
-    in_route = front_section in il.section_lock
+    in_route = il.locks.section_locked(front_section)
     if not in_route and front_section and sim.station.sections[front_section].role.value in ("spur", "station_track"):
         # on a depot or station track beyond the end of its route: the movement goes on under the shunting order up
         # to a safe distance before the next signal or buffer stop (the track holds no turnouts to lock)

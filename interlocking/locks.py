@@ -1,0 +1,152 @@
+"""The lock ledger (锁闭): every lock the interlocking holds on a section or a turnout, who holds it and why.
+
+One question has one answer here: *is this turnout locked, by whom, why?* A turnout is locked when something locks
+it directly (a route or an overlap that runs over it or protects it, single lock 单锁, guide total lock 引导总锁闭)
+or when the section it stands in is locked by a route, an overlap or the power-up lock (上电锁闭): a turnout in a
+route-locked section is locked with it. A fouling section (侵限区段) a route checks is held too, but holding it
+locks no turnout: several routes may check the same fouling section.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import dataclass
+from enum import StrEnum
+
+
+class Hold(StrEnum):
+    route = "route"  # 进路锁闭: a route's section or turnout
+    overlap = "overlap"  # 延续进路
+    fouling = "fouling"  # a fouling section a route checks
+    single = "single"  # 单锁
+    guide = "guide"  # 引导总锁闭 of a throat
+    power_up = "power-up"  # 上电锁闭: since the interlocking started, until the power-up release
+
+
+_LOCKS_TURNOUTS = frozenset({Hold.route, Hold.overlap, Hold.power_up})
+
+
+@dataclass(frozen=True)
+class Lock:
+    hold: Hold
+    holder: str = ""  # route id, throat name, or '' (single lock, power-up)
+
+    def words(self) -> str:
+        """How a section or turnout is locked, to follow 'is locked': 'in route X-XI', ..."""
+        return {Hold.route: f"in route {self.holder}", Hold.overlap: f"in route {self.holder} (its overlap)",
+                Hold.fouling: f"in route {self.holder} (a fouling section)", Hold.single: "by single lock (单锁)",
+                Hold.guide: f"by guide total lock (引导总锁闭) of throat {self.holder}",
+                Hold.power_up: "since the interlocking started (上电锁闭)"}[self.hold]
+
+
+class LockLedger:
+    """``pairs``: crossover pairs (双动道岔), whose two turnouts move together: a lock on one holds both."""
+
+    def __init__(self, turnout_section: dict[str, str], pairs: dict[str, list[str]] | None = None) -> None:
+        self.turnout_section = turnout_section
+        self.partner: dict[str, str] = {}
+        for members in (pairs or {}).values():
+            for t in members:
+                self.partner.update({m: t for m in members if m != t})
+        self.sections: dict[str, set[Lock]] = {}
+        self.turnouts: dict[str, set[Lock]] = {}
+        self.blocked: set[str] = set()  # 单封: no route over the turnout (not a lock: individual operation stays)
+        self.version = 0  # counts changes, so a reader can tell when nothing changed
+
+    # ---- taking and giving back -----------------------------------------------------------------------------------
+    def lock_section(self, section: str, hold: Hold, holder: str = "") -> None:
+        self.version += 1
+        self.sections.setdefault(section, set()).add(Lock(hold, holder))
+
+    def unlock_section(self, section: str, hold: Hold, holder: str = "") -> None:
+        self.version += 1
+        locks = self.sections.get(section)
+        if locks is not None:
+            locks.discard(Lock(hold, holder))
+            if not locks:
+                del self.sections[section]
+
+    def lock_turnout(self, turnout: str, hold: Hold, holder: str = "") -> None:
+        self.version += 1
+        self.turnouts.setdefault(turnout, set()).add(Lock(hold, holder))
+
+    def unlock_turnout(self, turnout: str, hold: Hold, holder: str = "") -> None:
+        self.version += 1
+        locks = self.turnouts.get(turnout)
+        if locks is not None:
+            locks.discard(Lock(hold, holder))
+            if not locks:
+                del self.turnouts[turnout]
+
+    def release(self, hold: Hold, holder: str = "") -> None:
+        """Give back every lock ``holder`` holds as ``hold``."""
+        self.version += 1
+        lock = Lock(hold, holder)
+        for table in (self.sections, self.turnouts):
+            for key in [k for k, locks in table.items() if lock in locks]:
+                table[key].discard(lock)
+                if not table[key]:
+                    del table[key]
+
+    def release_all(self, hold: Hold) -> None:
+        self.version += 1
+        for table in (self.sections, self.turnouts):
+            for key in list(table):
+                table[key] = {lk for lk in table[key] if lk.hold is not hold}
+                if not table[key]:
+                    del table[key]
+
+    # ---- questions ----------------------------------------------------------------------------------------------
+    def section_locks(self, section: str) -> set[Lock]:
+        return self.sections.get(section, set())
+
+    def section_locked(self, section: str) -> bool:
+        return section in self.sections
+
+    def section_holders(self, section: str, holds: Iterable[Hold] = (Hold.route, Hold.overlap)) -> list[str]:
+        want = set(holds)
+        return sorted(lk.holder for lk in self.sections.get(section, ()) if lk.hold in want)
+
+    def _own_locks(self, turnout: str) -> list[tuple[Lock, str]]:
+        """Locks through the turnout's section first (they name the section), then those on the turnout itself."""
+        out: list[tuple[Lock, str]] = []
+        sec = self.turnout_section.get(turnout)
+        if sec is not None:
+            out += [(lk, sec) for lk in sorted(self.sections.get(sec, ()), key=_order) if lk.hold in _LOCKS_TURNOUTS]
+        return out + [(lk, "") for lk in sorted(self.turnouts.get(turnout, ()), key=_order)]
+
+    def turnout_locks(self, turnout: str) -> list[tuple[Lock, str, str]]:
+        """Every lock holding ``turnout``: (lock, section it comes through or '', the crossover partner it comes
+        through or '')."""
+        out = [(lk, sec, "") for lk, sec in self._own_locks(turnout)]
+        partner = self.partner.get(turnout)
+        if partner is not None:
+            out += [(lk, sec, partner) for lk, sec in self._own_locks(partner)]
+        return out
+
+    def turnout_locked(self, turnout: str) -> bool:
+        return bool(self._own_locks(turnout)) or (turnout in self.partner and bool(self._own_locks(
+            self.partner[turnout])))
+
+    def why_turnout(self, turnout: str) -> str:
+        """Why ``turnout`` may not move, in a signaller's words ('' when it may)."""
+        locks = self.turnout_locks(turnout)
+        if not locks:
+            return ""
+        lk, via, partner = locks[0]
+        who = f"turnout {turnout}" if not partner else f"turnout {turnout} moves with {partner}, which"
+        if lk.hold is Hold.single:
+            return f"{who} is single-locked (单锁): unlock it first"
+        if not via:
+            return f"{who} is locked {lk.words()}"
+        if lk.hold is Hold.route and (lk, "", partner) in locks:
+            return f"{who} is locked {lk.words()}: it stands in section {via}, locked in that route"
+        return f"{who} stands in section {via}, locked {lk.words()}"
+
+    def holders(self, turnout: str) -> set[str]:
+        """Routes that hold ``turnout`` directly (by route or overlap lock)."""
+        return {lk.holder for lk in self.turnouts.get(turnout, ()) if lk.hold in (Hold.route, Hold.overlap)}
+
+
+def _order(lk: Lock) -> tuple[int, str]:
+    return (list(Hold).index(lk.hold), lk.holder)
