@@ -67,39 +67,6 @@ def cmd_table(args: argparse.Namespace) -> int:
     return 0
 
 
-def cmd_test(args: argparse.Namespace) -> int:
-    from pathlib import Path
-
-    from .scripts import Outcome, parse_script, run_script
-
-    outcomes: list[Outcome] = []
-    broken = 0
-    for f in args.files:
-        try:
-            script = parse_script(Path(f))
-            outcomes += run_script(script, args.k)
-        except StationError as exc:
-            for d in exc.diagnostics:
-                print(d, file=sys.stderr)
-            broken += 1
-    for o in outcomes:
-        if o.passed:
-            print(f"PASS {o.script}: {o.name}")
-        else:
-            print(f"FAIL {o.script}:{o.line}: {o.name}\n    {o.failure}")
-            if args.verbose:
-                for entry in o.log:
-                    print(f"      {entry}")
-    if args.junit_xml:
-        from .junit import write_junit
-
-        write_junit(args.junit_xml, outcomes)
-    passed = sum(o.passed for o in outcomes)
-    failed = len(outcomes) - passed + broken
-    print(f"{passed} passed, {failed} failed")
-    return 0 if failed == 0 and outcomes else 1
-
-
 def cmd_run(args: argparse.Namespace) -> int:
     from pathlib import Path
 
@@ -154,11 +121,6 @@ def build_parser() -> argparse.ArgumentParser:
     sp = add("table", cmd_table, "print the interlocking table (联锁表) derived from the topology")
     sp.add_argument("station", help="bundled station name or path")
     sp.add_argument("--format", choices=("text", "csv", "json"), default="text")
-    sp = add("test", cmd_test, "run YAML route-test scripts")
-    sp.add_argument("files", nargs="+", help="test script files")
-    sp.add_argument("-k", metavar="TEXT", help="run only tests whose name contains TEXT")
-    sp.add_argument("-v", "--verbose", action="store_true", help="print every step of failing tests")
-    sp.add_argument("--junit-xml", metavar="FILE", help="also write a JUnit XML report")
     sp = add("bench", cmd_bench, "benchmark table building and the interlocking cycle (hub and jiaopei)")
     sp.add_argument("--quick", action="store_true", help="fewer cycles (under a minute)")
     sp.add_argument("--format", choices=("json", "text"), default="json")
@@ -171,19 +133,14 @@ def build_parser() -> argparse.ArgumentParser:
     from .zpwcli import register as register_zpw
 
     register_zpw(add)
-    from .verify.cli import register as register_verify
-
-    register_verify(add)
-    from .soakcli import register as register_soak
-
-    register_soak(add)
     _register_plugins(add)
     return p
 
 
 def _register_plugins(add: Callable[..., argparse.ArgumentParser]) -> None:
-    """Subcommands of the layers above (the console: ``liansuo tui``, ``liansuo replay``), found through the
-    ``liansuo.commands`` entry-point group so this module never imports them."""
+    """Subcommands of the layers above (proving: ``liansuo test``, ``verify``, ``soak``; the console: ``liansuo
+    tui``, ``replay``), found through the ``liansuo.commands`` entry-point group so this module never imports
+    them."""
     from importlib.metadata import entry_points
 
     for ep in entry_points(group="liansuo.commands"):

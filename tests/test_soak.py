@@ -11,8 +11,8 @@ import yaml
 
 from interlocking.engine import Engine
 from interlocking.state import RouteStage, RouteState
+from proving.soak import soak
 from simulation.cli import main
-from simulation.soak import soak
 
 
 def test_soak_reports_steps_and_no_violations(capsys: pytest.CaptureFixture[str]) -> None:

@@ -1,7 +1,9 @@
-"""One experiment of the interlocking test: a fresh simulation driven only through the command language.
+"""One experiment of the interlocking test: a fresh simulation driven only through the command language, with the
+safety oracle watching every cycle.
 
 Every line a probe sends (and every stretch of simulated time it waits) is kept, so a failed check comes with a YAML
-test script that replays it (``liansuo test``).
+test script that replays it (``liansuo test``). Whatever the oracle finds during any probe is a failure of its own
+(check ``oracle``), whichever item of the test the probe was for.
 """
 
 from __future__ import annotations
@@ -13,9 +15,10 @@ from interlocking.aspects import is_open, stop_aspect
 from interlocking.io import Result
 from interlocking.rules import RuleSet
 from interlocking.table import InterlockingTable, Route
+from simulation.sim import Simulation
 from stations.station import Station
 
-from ..sim import Simulation
+from ..oracle import Watch
 
 
 @dataclass
@@ -42,40 +45,68 @@ class Context:
     checks: int = 0
     failures: list[Failure] = field(default_factory=list)
     warnings: list[Failure] = field(default_factory=list)
+    oracle_seen: set[str] = field(default_factory=set)  # what the oracle found, once each
+
+    stop_at_first: bool = False  # raise FirstFailure at the first failure (for the mutation run)
 
     def record(self, ok: bool, check: str, subject: str, detail: str, probe: Probe | None = None) -> bool:
         self.checks += 1
         if not ok:
-            self.failures.append(Failure(check, subject, detail, probe.script() if probe else []))
+            self.fail(Failure(check, subject, detail, probe.script() if probe else []))
         return ok
+
+    def fail(self, failure: Failure) -> None:
+        self.failures.append(failure)
+        if self.stop_at_first:
+            raise FirstFailure(failure)
+
+
+class FirstFailure(Exception):
+    """The first failure of a verify run asked to stop there."""
 
 
 class Probe:
     def __init__(self, ctx: Context) -> None:
         self.ctx = ctx
         self.sim = Simulation(ctx.station, cycle_s=ctx.cycle_s, rules=ctx.rules, table=ctx.table)
+        self.watch = Watch(self.sim)
+        self._reported = 0
         self.lines: list[str] = []
         self._cycles = 0  # cycles run since the last line written
+
+    def _oracle(self) -> None:
+        """Record what the oracle found since the last look, each finding once per verify run."""
+        found = self.watch.violations
+        for v in found[self._reported:]:
+            if v.text not in self.ctx.oracle_seen:
+                self.ctx.oracle_seen.add(v.text)
+                self.ctx.fail(Failure("oracle", v.prop, f"at t = {v.t:g} s: {v.text}", self.script()))
+        self._reported = len(found)
 
     # ---- driving ------------------------------------------------------------------------------------------------
     def do(self, line: str) -> Result:
         self._flush()
         self.lines.append(line)
-        return self.sim.command(line)
+        result = self.sim.command(line)
+        self._oracle()
+        return result
 
     def run(self, seconds: float) -> None:
         n = max(1, round(seconds / self.ctx.cycle_s))
         for _ in range(n):
             self.sim.step()
         self._cycles += n
+        self._oracle()
 
     def until(self, done: Callable[[], bool], timeout_s: float) -> bool:
         """Run cycle by cycle until ``done()`` holds or ``timeout_s`` of simulated time passed."""
         for _ in range(round(timeout_s / self.ctx.cycle_s)):
             if done():
+                self._oracle()
                 return True
             self.sim.step()
             self._cycles += 1
+        self._oracle()
         return done()
 
     def expect(self, what: str) -> Result:
@@ -135,13 +166,21 @@ def turnout_groups(station: Station, r: Route) -> list[tuple[str, str]]:
 
 def prepare(p: Probe, r: Route) -> None:
     """Liaison a route needs before its signal may open: a 64D departure asks the neighbour (闭塞) and waits for
-    its acceptance."""
+    its acceptance; a departure against the running direction of a bidirectional line changes its direction (改方)."""
     il = p.sim.interlocking
+    if r.exit_link in il.auto_links and against_running(p.ctx.station, r.exit_link) \
+            and not p.sim.line_outbound(r.exit_link):
+        p.do(f"line-direction {r.exit_link} out")
     link = il.links.get(r.exit_link or "")
     if link is None or link.state.value != "idle":
         return
     p.do(f"block-line {link.id} request")
     p.until(lambda: link.state.value == "permitted", 10.0)
+
+
+def against_running(station: Station, link: str) -> bool:
+    """A departure onto ``link`` runs against its running direction (towards this station)."""
+    return station.link_running(link) == "inbound"
 
 
 def open_route(p: Probe, *routes: Route, timeout_s: float = 40.0) -> bool:

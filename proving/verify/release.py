@@ -7,11 +7,11 @@ from __future__ import annotations
 from functools import partial
 from typing import TYPE_CHECKING
 
-from interlocking.aspects import is_open
+from interlocking.aspects import ORDER, is_open
 from interlocking.table import Route
 from stations.schema import SignalKind
 
-from .probe import Context, Failure, Probe, open_route, other, route_line
+from .probe import Context, Failure, Probe, against_running, open_route, other, route_line
 
 if TYPE_CHECKING:
     from .routes import RouteTest
@@ -28,8 +28,10 @@ class ReleaseChecks:
         self.cancel()
         self.time_release()
         self.normal_release()
+        self.flicker()
         self.fault_release()
         self.guide()
+        self.lamps()
         self.doors()
         self.aspects()
 
@@ -95,7 +97,8 @@ class ReleaseChecks:
         r, p = self.r, Probe(self.ctx)
         if not self.rt.opened(p, "opens"):
             return
-        sig, secs = r.signal, r.sections
+        rs = p.sim.interlocking.routes[r.id]
+        sig, secs, beyond = r.signal, rs.sections, p.sim.interlocking.beyond(rs)  # with the run-on, if any
         for s in r.approach:
             p.do(f"occupy {s}")
         p.run(1.0)
@@ -126,13 +129,13 @@ class ReleaseChecks:
                                      + ([f"not locked ahead of it: {', '.join(ahead)}"] if ahead else [])), p):
                 return
         if r.category != "receiving":
-            if r.beyond is not None:
-                p.do(f"occupy {r.beyond}")
+            if beyond is not None:
+                p.do(f"occupy {beyond}")
                 p.run(1.0)
             p.do(f"vacate {secs[-1]}")
             p.run(1.0)
         done = p.until(lambda: p.state(r) == "released", 5.0)
-        held = [s for s in r.sections if p.sim.section_state(s) == "locked"]
+        held = [s for s in secs if p.sim.section_state(s) == "locked"]
         if not self.rt.check(done and not held, "sequential-release", f"after the train the route is {p.state(r)}"
                              + (f", still locked: {', '.join(held)}" if held else ""), p):
             return
@@ -143,12 +146,45 @@ class ReleaseChecks:
         else:
             self.na("overlap")
 
+    def flicker(self) -> None:
+        """The three-point check (三点检查): a section that shows clear again before the next one is occupied (a
+        track circuit flickering under the train, a vehicle in a dead zone) is not released."""
+        r = self.r
+        if len(r.sections) < 2 or not r.approach:
+            self.na("three-point check (one section)")
+            return
+        p = Probe(self.ctx)
+        if not self.rt.opened(p, "opens"):
+            return
+        first, second = r.sections[0], r.sections[1]
+        for a in r.approach:
+            p.do(f"occupy {a}")
+        p.run(1.0)
+        p.do(f"occupy {first}")
+        p.run(1.0)
+        for a in r.approach:
+            p.do(f"vacate {a}")
+        p.run(1.0)
+        p.do(f"vacate {first}")
+        p.run(1.0)
+        self.rt.check(p.sim.section_state(first) == "locked", "three-point-check",
+                      f"{first} was occupied and showed clear again with {second} still clear: it was released "
+                      f"({p.sim.section_state(first)}); it must wait for the next section to be occupied", p)
+
     def overlap(self, p: Probe) -> None:
         r = self.r
         held = [s for s in r.overlap_sections if p.sim.section_state(s) != "locked"]
         if not self.rt.check(not held, "overlap", f"the train stands on {r.sections[-1]}: overlap sections not "
                              f"locked: {', '.join(held)}", p):
             return
+        rivals = [o for o in self.ctx.table.routes.values() if o.signal != r.signal and o.signal != r.end_signal
+                  and set(o.sections) & set(r.overlap_sections)]
+        for o in rivals[:2]:
+            result = p.do(route_line(o))
+            self.rt.check(not result.ok, "overlap", f"'{route_line(o)}' over the overlap of {r.id} while it is held: "
+                          f"{result.message}", p)
+            if result.ok:
+                p.do(f"cancel {o.signal}")
         p.run(r.overlap_release_s - 3.0)
         held = [s for s in r.overlap_sections if p.sim.section_state(s) != "locked"]
         if not self.rt.check(not held, "overlap", f"overlap released early ({', '.join(held)}), before its "
@@ -205,6 +241,17 @@ class ReleaseChecks:
         faulty = r.sections[-1]
         p.do(f"occupy {faulty}")
         p.run(1.0)
+        if r.turnouts:  # a guide route still needs every turnout in position with its indication
+            t = r.turnouts[0].id
+            p.do(f"fault no-indication {t}")
+            p.run(1.0)
+            result = p.do(f"guide {r.signal}")
+            p.run(1.0)
+            self.rt.check(not result.ok and not p.is_open(r.signal), "guide", f"'guide {r.signal}' with turnout {t} "
+                          f"of the route without indication: {result.message}; the signal shows "
+                          f"{p.aspect(r.signal)}", p)
+            p.do(f"repair no-indication {t}")
+            p.run(1.0)
         result = p.do(f"guide {r.signal}")
         p.run(1.0)
         if not self.rt.check(result.ok and p.aspect(r.signal) == "HB", "guide",
@@ -216,12 +263,31 @@ class ReleaseChecks:
         for a in r.approach:
             p.do(f"occupy {a}")
         p.run(1.0)
-        p.do(f"occupy {r.sections[0]}")
-        for a in r.approach:
-            p.do(f"vacate {a}")
-        p.run(1.0)
-        self.rt.check(p.closed(r.signal), "guide", f"the guided train has passed {r.signal}: it still shows "
+        self.rt.check(p.aspect(r.signal) == "HB", "guide", f"the guided train approaches {r.signal}: it shows "
                       f"{p.aspect(r.signal)}", p)
+        p.do(f"occupy {r.sections[0]}")
+        p.run(0.5)
+        self.rt.check(p.closed(r.signal), "guide", f"the guided train entered {r.sections[0]} (its tail still in the "
+                      f"approach): {r.signal} still shows {p.aspect(r.signal)}", p)
+
+    def lamps(self) -> None:
+        """A lamp of the aspect shown goes dark (both filaments): the interlocking commands a more restrictive
+        aspect (the rule set's downgrade), never keeps the one it can no longer show."""
+        r = self.r
+        p = Probe(self.ctx)
+        if not self.rt.opened(p, "opens"):
+            return
+        shown = p.aspect(r.signal)
+        lamps = [lamp for lamp in self.ctx.rules.lamps.get(shown, [])
+                 if lamp in {x.value for x in self.st.signals[r.signal].lamps}]
+        if not lamps:
+            return
+        lamp = lamps[0]
+        p.do(f"fault filament {r.signal} lamp={lamp} which=both")
+        p.run(1.0)
+        after = p.aspect(r.signal)
+        self.rt.check(after != shown and ORDER.get(after, 0) <= ORDER.get(shown, 0), "lamp-proving",
+                      f"lamp {lamp} of {r.signal} dark while it showed {shown}: the interlocking commands {after}", p)
 
     def door_platforms(self) -> list[str]:
         rear = self.st.signal_rear_track(self.r.signal)
@@ -299,6 +365,13 @@ class ReleaseChecks:
         if link is None or link.kind.value != "automatic":
             return
         signal = departure.signal
+        if against_running(self.st, link.id):
+            # worked against its running direction (改方) the line is one block: any section occupied closes it
+            p.do(f"occupy {link.sections[-1]}")
+            p.run(1.0)
+            self.rt.check(p.closed(signal), "aspect", f"line {link.id} worked against its running direction is one "
+                          f"block: with {link.sections[-1]} occupied {signal} shows {p.aspect(signal)}", p)
+            return
         for n, s in ((2, link.sections[2:3]), (1, link.sections[1:2])):
             if not s:
                 continue

@@ -11,8 +11,10 @@ tests:
 ```
 Each test runs on a fresh simulation. A command that is refused fails the test unless the next step is
 ``expect refused ...``. A failing step prints the step, what was expected and what the state was. With
-``safety: true`` a :class:`~simulation.safety.SafetyChecker` watches every cycle and a violation of a safety property
-fails the test at the step where it happens (``liansuo soak`` writes its reproducers this way).
+``safety: true`` the safety oracle (:class:`~proving.oracle.Watch`) watches every cycle and a violation of a safety
+property fails the test at the step where it happens (``liansuo soak`` writes its reproducers this way); a hazard (a
+danger the interlocking cannot see by design, such as a vehicle hidden in a dead zone) is reported without failing the
+test, and ``expect hazard TEXT`` checks that one was seen.
 """
 
 from __future__ import annotations
@@ -20,12 +22,14 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from interlocking.io import Result
+from simulation.commands import read_steps
+from simulation.sim import Simulation
 from stations.loader import load
 from stations.source import Diagnostic, StationError, read_file
 from stations.station import Station
 
-from .commands import read_steps
-from .sim import Simulation
+from .oracle import Watch
 
 
 @dataclass
@@ -58,6 +62,7 @@ class Outcome:
     failure: str = ""
     line: int = 0
     log: list[str] = field(default_factory=list)
+    hazards: list[str] = field(default_factory=list)  # what the oracle found that the interlocking cannot see
 
 
 def parse_script(path: Path) -> Script:
@@ -127,20 +132,16 @@ def run_script(script: Script, only: str | None = None) -> list[Outcome]:
 
 def run_test(script: Script, test: ScriptTest, station: Station, table: object) -> Outcome:
     sim = Simulation(station, cycle_s=script.cycle_s, table=table)  # type: ignore[arg-type]
-    checker = None
-    if script.safety:
-        from .safety import SafetyChecker
-
-        checker = SafetyChecker(sim)
+    checker = Watch(sim) if script.safety else None
     log: list[str] = []
     steps = test.steps
     for k, step in enumerate(steps):
-        result = sim.command(step.text)
+        result = _expect_hazard(step.text, checker) or sim.command(step.text)
         log.append(f"{step.text} -> {'ok' if result.ok else 'refused'}: {result.message}")
         if checker is not None and checker.violations:
             v = checker.violations[0]
             return Outcome(script.file, test.name, False, f"step '{step.text}': safety violation at t = {v.t:g} s "
-                           f"({v.prop}): {v.text}", step.line, log)
+                           f"({v.prop}): {v.text}", step.line, log, _hazards(checker))
         is_expect = step.text.strip().startswith("expect")
         if result.ok:
             continue
@@ -149,7 +150,25 @@ def run_test(script: Script, test: ScriptTest, station: Station, table: object) 
             if nxt.startswith("expect refused"):
                 continue
             return Outcome(script.file, test.name, False,
-                           f"step '{step.text}' was refused: {result.message}", step.line, log)
+                           f"step '{step.text}' was refused: {result.message}", step.line, log, _hazards(checker))
         return Outcome(script.file, test.name, False, f"step '{step.text}': {result.message} (t = {sim.t:g} s)",
-                       step.line, log)
-    return Outcome(script.file, test.name, True, log=log)
+                       step.line, log, _hazards(checker))
+    return Outcome(script.file, test.name, True, log=log, hazards=_hazards(checker))
+
+
+def _expect_hazard(line: str, checker: Watch | None) -> Result | None:
+    """``expect hazard TEXT``: the oracle has reported a hazard (a danger the interlocking cannot see by design)
+    whose text contains TEXT; needs ``safety: true``. None for any other line."""
+    words = line.split("#", 1)[0].split()
+    if words[:2] != ["expect", "hazard"]:
+        return None
+    if checker is None:
+        return Result.refuse("'expect hazard' needs the safety oracle: add 'safety: true' to the script")
+    text = " ".join(words[2:]).lower()
+    seen = [h.text for h in checker.hazards]
+    hits = [h for h in seen if text in h.lower()]
+    return Result(bool(hits), f"hazards: {'; '.join(seen) or 'none'}")
+
+
+def _hazards(checker: Watch | None) -> list[str]:
+    return [f"t = {h.t:g} s {h.prop}: {h.text}" for h in checker.hazards] if checker is not None else []

@@ -16,11 +16,11 @@ from dataclasses import dataclass, field
 
 from interlocking.aspects import is_open
 from interlocking.table import Route
+from simulation.commands import COMMANDS
+from simulation.sim import Simulation
 from stations.schema import Direction
 
-from .commands import COMMANDS
-from .safety import SafetyChecker, Violation
-from .sim import Simulation
+from .oracle import Violation, Watch
 
 WALK_STEP_M = 12.0  # a walker's wheelsets advance this far per step
 MAX_TRAINS = 3
@@ -85,7 +85,7 @@ class StepGenerator:
         sig = self.rng.choice(busy) if busy and self.rng.random() < 0.85 else self.rng.choice(self.signals)
         op = self.rng.choices(["cancel", "release", "reopen", "guide"], [4, 3, 4, 1])[0]
         if op == "release" and self.rng.random() < 0.3:
-            locked = sorted(il.section_lock)
+            locked = sorted(il.locks.sections)
             if locked:
                 return [f"fault-release {self.rng.choice(locked)}"]
         return [f"{op} {sig}"]
@@ -262,10 +262,10 @@ class SoakRun:
 
 
 def soak(station: str, steps: int, seed: int, *, cycle_s: float = 0.25, sim: Simulation | None = None) -> SoakRun:
-    """Run ``steps`` random steps with a :class:`SafetyChecker` attached; the run is kept as command lines."""
+    """Run ``steps`` random steps with the safety oracle watching; the run is kept as command lines."""
     t0 = time.perf_counter()
     sim = sim or Simulation(station, cycle_s=cycle_s)
-    checker = SafetyChecker(sim)
+    checker = Watch(sim)
     gen = StepGenerator(sim, random.Random(seed))
     run = SoakRun(sim.station.id, seed, steps)
     pending = 0  # cycles run since the last line

@@ -13,6 +13,7 @@ from collections.abc import Iterable
 from functools import partial
 
 from interlocking.table import Route
+from stations.schema import TurnoutPosition
 
 from .probe import Context, Probe, open_route, prepare, route_line
 
@@ -27,6 +28,11 @@ def conflicting(a: Route, b: Route) -> bool:
     return b.id in a.conflicts or a.id in b.conflicts or a.signal == b.signal
 
 
+def conditional(a: Route, b: Route) -> bool:
+    """Enemies only for some ways the turnouts beyond a shunting route's end lie."""
+    return b.id in a.conditional or a.id in b.conditional
+
+
 class PairTest:
     def __init__(self, ctx: Context) -> None:
         self.ctx = ctx
@@ -38,20 +44,53 @@ class PairTest:
         order = list(routes)
         for i, a in enumerate(order):
             rivals = [b for b in order if b is not a and conflicting(a, b) and (not focus or {a.id, b.id} & focus)]
-            later = [b for b in order[i + 1:] if not conflicting(a, b) and (not focus or {a.id, b.id} & focus)]
+            later = [b for b in order[i + 1:] if not conflicting(a, b) and not conditional(a, b)
+                     and (not focus or {a.id, b.id} & focus)]
             for b in order[i + 1:]:
                 if focus and a.id not in focus and b.id not in focus:
                     continue
                 self.tested += 1
                 if conflicting(a, b):
                     self.conflicting += 1
+                elif conditional(a, b):
+                    self.conflicting += 1
+                    self.compatible += 1
+                    self.conditionally(a, b)
                 else:
                     self.compatible += 1
-                if (b.id in a.conflicts) != (a.id in b.conflicts):
+                if (b.id in a.conflicts) != (a.id in b.conflicts) or (b.id in a.conditional) != (
+                        a.id in b.conditional):
                     self.ctx.record(False, "conflict-symmetry", f"{a.id} + {b.id}",
                                     "the table lists the conflict on one route only")
             if rivals or later:
                 self.first(a, rivals, later)
+
+    def conditionally(self, a: Route, b: Route) -> None:
+        """A pair that conflicts only for some ways the turnouts beyond a shunting route's end lie: with them lying
+        so, the second is refused; lying a way no condition names, both are set and open together."""
+        conds = [c for c, _ in a.conditional.get(b.id, ())]
+        p = Probe(self.ctx)
+        self._lay(p, dict(conds[0]))
+        prepare(p, a)
+        first = p.do(route_line(a))
+        second = p.do(route_line(b))
+        self.ctx.record(first.ok and not second.ok, "conflict", f"{a.id} + {b.id}",
+                        f"with {_words(dict(conds[0]))}, {b.id} conflicts with {a.id} but "
+                        f"'{route_line(a)}' was {_word(first.ok)} and '{route_line(b)}' {_word(second.ok)}", p)
+        free = next((w for w in _ways(a, b) if not any(all(w.get(t) is pos for t, pos in c) for c in conds)), None)
+        if free is None:
+            return
+        p = Probe(self.ctx)
+        self._lay(p, free)
+        ok = open_route(p, a, b, timeout_s=SETTLE_S)
+        self.ctx.record(ok, "compatible", f"{a.id} + {b.id}", f"with {_words(free)} they do not conflict but "
+                        f"could not both be set and open: {p.blocker(a)}; {p.blocker(b)}", p)
+
+    @staticmethod
+    def _lay(p: Probe, positions: dict[str, TurnoutPosition]) -> None:
+        for t, pos in positions.items():
+            p.do(f"throw {t} {pos.value}")
+        p.until(lambda: all(p.sim.turnout_state(t)[0] == pos.value for t, pos in positions.items()), SETTLE_S)
 
     def why(self, a: Route, b: Route) -> str:
         return a.conflicts.get(b.id) or b.conflicts.get(a.id) or f"both start at {a.signal}"
@@ -110,3 +149,23 @@ class PairTest:
         self.ctx.record(False, "compatible", f"{a.id} + {b.id}", f"{a.id} and {b.id} do not conflict but could not "
                         f"both be set and open: {detail}" + (" (only after the routes tried before it)" if ok else ""),
                         p)
+
+
+def _ways(a: Route, b: Route) -> list[dict[str, TurnoutPosition]]:
+    """Every way the turnouts beyond both routes' ends may lie together."""
+    out = []
+    for wa in [ro.when for ro in a.run_on] or [()]:
+        for wb in [ro.when for ro in b.run_on] or [()]:
+            merged = dict(wa)
+            if all(merged.get(t, p) is p for t, p in wb):
+                merged.update(dict(wb))
+                out.append(merged)
+    return out
+
+
+def _words(positions: dict[str, TurnoutPosition]) -> str:
+    return ", ".join(f"turnout {t} {p.value}" for t, p in sorted(positions.items()))
+
+
+def _word(ok: bool) -> str:
+    return "accepted" if ok else "refused"

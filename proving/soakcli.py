@@ -1,5 +1,5 @@
 """``liansuo soak STATION --steps N --seed S [--format text|json] [--out DIR]``: long random runs under the safety
-checker, with a reproducer script for each violation.
+oracle, with a reproducer script for each violation.
 
 A reproducer is a YAML test script with ``safety: true``: ``liansuo test FILE`` (or pytest) replays the commands and
 fails at the step where the violation happens. It is cut down from the run: first the shortest tail of the commands
@@ -16,8 +16,9 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
-from .safety import SafetyChecker, Violation
-from .sim import Simulation
+from simulation.sim import Simulation
+
+from .oracle import Violation, Watch
 from .soak import SoakRun, soak
 
 Add = Callable[..., argparse.ArgumentParser]
@@ -28,7 +29,7 @@ SHRINK_BUDGET_S = 30.0
 def shows(station: str, lines: list[str], key: str, cycle_s: float = 0.25) -> bool:
     """Do ``lines`` on a fresh simulation lead to a violation with ``key``?"""
     sim = Simulation(station, cycle_s=cycle_s)
-    checker = SafetyChecker(sim)
+    checker = Watch(sim)
     for line in lines:
         sim.command(line)
         if any(v.key == key for v in checker.violations):
@@ -73,13 +74,26 @@ def merge_runs(lines: list[str]) -> list[str]:
     return out
 
 
+def annotate_refusals(station: str, lines: list[str], cycle_s: float = 0.25) -> list[str]:
+    """The lines with ``expect refused ...`` after each command a fresh station refuses, so that the script replays
+    under ``liansuo test`` (where a refused command otherwise fails the test) up to the violation."""
+    sim = Simulation(station, cycle_s=cycle_s)
+    out: list[str] = []
+    for line in lines:
+        out.append(line)
+        result = sim.command(line)
+        if not result.ok and not line.startswith("run "):
+            out.append(f"expect refused {result.message[:60]}")
+    return out
+
+
 def reproducer(run: SoakRun, v: Violation, lines: list[str]) -> str:
     import yaml
 
-    lines = merge_runs(lines)
+    lines = annotate_refusals(run.station, merge_runs(lines))
 
     head = (f"# liansuo soak {run.station} --seed {run.seed}: at t = {v.t:g} s, {v.prop}: {v.text}\n"
-            f"# Replays with the safety checker on: 'liansuo test FILE' fails at the step where it happens.\n")
+            f"# Replays with the safety oracle on: 'liansuo test FILE' fails at the step where it happens.\n")
     body = {"station": run.station, "safety": True,
             "tests": [{"name": f"soak seed {run.seed}: {v.prop} {v.key.partition(':')[2]}", "steps": lines}]}
     return head + yaml.safe_dump(body, allow_unicode=True, sort_keys=False, width=200)
@@ -130,7 +144,7 @@ def cmd_soak(args: argparse.Namespace) -> int:
 
 
 def register(add: Add) -> None:
-    sp = add("soak", cmd_soak, "random operation under the safety checker; a reproducer script per violation")
+    sp = add("soak", cmd_soak, "random operation under the safety oracle; a reproducer script per violation")
     sp.add_argument("station", help="bundled station name or path to a station YAML file")
     sp.add_argument("--steps", type=int, default=10_000, help="random steps (default 10000)")
     sp.add_argument("--seed", type=int, default=1)

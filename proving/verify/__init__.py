@@ -17,9 +17,14 @@ from interlocking.table import InterlockingTable, build_table
 from stations.loader import load
 from stations.station import Station
 
+from ..oracle.pairs import PaperOracle
+from .against import approach_extent, pair_conflicts, route_demands
+from .data import check_station
 from .pairs import PairTest
-from .probe import Context, Failure
+from .probe import Context, Failure, FirstFailure
+from .release import throat_checks
 from .routes import RouteResult, RouteTest
+from .station import power_up, red_lamp_transfer
 
 
 @dataclass
@@ -63,27 +68,43 @@ class VerifyReport:
 
 
 def verify_station(station: str | Path | Station, *, routes: list[str] | None = None, pairs: bool = True,
-                   strict: bool = False, rules: RuleSet | None = None, cycle_s: float = 0.25) -> VerifyReport:
-    """Run the whole interlocking test; ``routes`` limits route and pair checks to those routes."""
-    from .data import check_station
-    from .release import throat_checks
-
+                   strict: bool = False, rules: RuleSet | None = None, cycle_s: float = 0.25,
+                   stop_at_first: bool = False) -> VerifyReport:
+    """Run the whole interlocking test; ``routes`` limits route and pair checks to those routes. The table is held
+    against the oracle first (quick), then every route and pair is tried on the running simulation.
+    ``stop_at_first``: stop at the first failure (the mutation run only needs to know that one was found)."""
     t0 = time.perf_counter()
     st = station if isinstance(station, Station) else load(station)
-    table = build_table(st)
-    ctx = Context(st, table, rules or load_rules(), cycle_s)
+    rules = rules or load_rules()
+    table = build_table(st, rules)
+    ctx = Context(st, table, rules, cycle_s, stop_at_first=stop_at_first)
     focus = set(routes) if routes else None
-    if focus:
-        unknown = sorted(focus - set(table.routes))
-        for rid in unknown:
-            ctx.record(False, "route", rid, f"there is no route {rid}; see 'liansuo table {st.id}'")
-    results = [RouteTest(ctx, r).run() for r in table.routes.values() if not focus or r.id in focus]
+    results: list[RouteResult] = []
     pair_test = PairTest(ctx)
-    if pairs:
-        pair_test.run(table.routes.values(), focus)
-    if not focus:
-        throat_checks(ctx)
-    check_station(ctx, focus)
+    try:
+        if focus:
+            for rid in sorted(focus - set(table.routes)):
+                ctx.record(False, "route", rid, f"there is no route {rid}; see 'liansuo table {st.id}'")
+        oracle = PaperOracle(st, ctx.rules)
+        for r in table.routes.values():
+            if not focus or r.id in focus:
+                route_demands(ctx, oracle, r)
+        if pairs:
+            pair_conflicts(ctx, oracle, focus)
+        if not focus:
+            approach_extent(ctx)
+        for r in table.routes.values():
+            if not focus or r.id in focus:
+                results.append(RouteTest(ctx, r).run())
+        if pairs:
+            pair_test.run(table.routes.values(), focus)
+        if not focus:
+            throat_checks(ctx)
+            power_up(ctx)
+            red_lamp_transfer(ctx)
+        check_station(ctx, focus)
+    except FirstFailure:
+        pass
     return VerifyReport(st.id, st.display_name(), len(table.routes), len(results), pair_test.tested,
                         pair_test.conflicting, pair_test.compatible, ctx.checks, ctx.failures, ctx.warnings,
                         results, table, time.perf_counter() - t0, strict)

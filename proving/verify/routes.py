@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 from interlocking.aspects import ORDER
 from interlocking.table import Route
 
-from .probe import Context, Probe, open_route, other, prepare, route_line, turnout_groups
+from .probe import Context, Probe, against_running, open_route, other, prepare, route_line, turnout_groups
 
 SETTLE_S = 20.0  # long enough for any turnout move (the slowest machine 6.6 s, two batches) and a 64D acceptance
 
@@ -121,8 +121,24 @@ class RouteTest:
                        f"64D departure: signal {r.signal} shows {p.aspect(r.signal)} without the neighbour's "
                        "acceptance", p)
             prepare(p, r)
+        elif against_running(self.ctx.station, link.id):
+            # against the line's running direction: refused until the direction is changed (改方), which a line that
+            # is not bidirectional never allows
+            result = p.do(route_line(r))
+            self.check(not result.ok and "direction" in result.message, "line-direction",
+                       f"'{route_line(r)}' against the running direction of line {link.id} without a direction "
+                       f"change was {'accepted' if result.ok else 'refused: ' + result.message}", p)
+            if not link.bidirectional:
+                self.res.not_applicable.append("liaison (line not bidirectional)")
+                return
+            prepare(p, r)
+            p.do(route_line(r))
         else:
-            first = link.sections[0]
+            beyond = [s for s in link.sections if s not in r.sections]
+            if not beyond:  # the route itself runs over the line's sections to the boundary
+                self.res.not_applicable.append("liaison (the block sections are the route's own)")
+                return
+            first = beyond[0]
             p.do(f"occupy {first}")
             p.do(route_line(r))
             p.run(SETTLE_S)

@@ -1,0 +1,36 @@
+"""The checks are strong: seeded defects of the interlocking (proving/mutants.py) are caught by ``liansuo verify`` or
+the safety oracle, at least 95 % of them, and the report says by which check."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from proving.mutants import MUTANTS
+from proving.mutation import run_mutants
+from simulation.cli import main
+
+
+def test_at_least_twenty_distinct_defects_and_95_percent_caught() -> None:
+    assert len(MUTANTS) >= 20 and len({m.name for m in MUTANTS}) == len(MUTANTS)
+    results = run_mutants()
+    missed = [r.mutant for r in results if not r.by]
+    assert len(results) == len(MUTANTS)
+    assert (len(results) - len(missed)) / len(results) >= 0.95, f"not caught: {missed}"
+    by = {r.mutant: r for r in results}
+    # the defects the issue names, each caught by the check that sees it
+    assert by["no-head-on-enemies"].check == "omitted-conflict"
+    assert by["no-flank-protection"].check == "flank-protection"
+    assert by["usu-without-onward-check"].by == "oracle"
+    assert by["no-red-lamp-transfer-on-the-line"].by == "oracle"
+    assert by["no-three-point-check"].check == "three-point-check"
+    assert by["throw-ignores-section-locks"].by
+
+
+def test_the_mutate_command_reports_the_score(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["mutate", "--station", "jiaopei", "--mutant", "blind-to-occupancy", "--mutant",
+                 "cancel-ignores-approach", "--format", "json"]) == 0
+    rep = json.loads(capsys.readouterr().out)
+    assert rep["mutants"] == 2 and rep["caught"] == 2 and rep["score"] == 1.0
+    assert {r["caught_by"] for r in rep["results"]} == {"oracle", "verify"}
