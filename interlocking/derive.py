@@ -2,8 +2,9 @@
 flank protection, driven), sections, fouling sections, approach sections, overlap, diamonds, and where a shunting
 route runs on past its end. The enemy routes are :mod:`.conflicts`' work.
 
-Flank protection (防护道岔): the first turnout met from the free leg of a route turnout (directly, or across one joint
-within 250 m), met on its normal or reverse leg, must lie the other way, unless that way also leads into the route
+Flank protection (防护道岔): the first turnout met from the free leg of a route turnout (directly, or across joints
+within the throat, short of a signal that stops movements heading for the route), met on its normal or reverse leg,
+must lie the other way, unless that way also leads into the route
 (onto a track of the route or one crossing it at a diamond, as the other diagonal of a scissors crossover does).
 A diamond the route runs over is protected the same way: the turnouts whose legs lead onto the crossing track must
 lie away from it, so a route over one diagonal of a scissors crossover keeps the other pair normal.
@@ -27,7 +28,6 @@ from .conflicts import derive_conflicts
 from .route import KINDS, FoulingSection, InterlockingTable, Kind, Route, RouteTurnout, RunOn
 from .rules import RuleSet
 
-_FLANK_SEARCH_M = 250.0  # how far from a route turnout's unused leg a protection turnout is looked for
 _AT_SIGHT = (SectionRole.station_track, SectionRole.spur)
 
 
@@ -134,20 +134,19 @@ class _Builder:
 
         for t, pos in turnouts:
             track, node_from = st.leg_track(t, _other(pos).value), t
-            travelled, joints = 0.0, 0
+            joints = 0
             while track not in on_path:
                 a, b = st.track_ports[track]
                 far = b if a.node == node_from else a
-                travelled += st.track_length(track)
                 if joints == 1 and any(fp.track == track for fp in st.model.fouling_points):
                     # a fouling point on the first track past the joint: the joint lies inside the fouling limit
                     fouling.append(FoulingSection(st.tracks[track].section, t, pos))
-                if st.is_station_track(st.tracks[track].section):
+                if st.sections[st.tracks[track].section].role is not SectionRole.throat:
                     break
                 if far.leg is not None:
                     protect(far.node, far.leg)
                     break
-                if far.node not in st.joints or joints == 1 or travelled > _FLANK_SEARCH_M:
+                if far.node not in st.joints or self._guards(far.node, node_from):
                     break
                 lo, hi = st.joint_tracks(far.node)
                 track, node_from = (hi if lo == track else lo), far.node
@@ -164,6 +163,12 @@ class _Builder:
                     if far.leg is not None:
                         protect(far.node, far.leg)
         return protection, list(dict.fromkeys(fouling))
+
+    def _guards(self, joint: str, behind: str) -> bool:
+        """Does a signal at ``joint`` face movements heading from it towards ``behind`` (so it stops them)?"""
+        st = self.st
+        towards = Direction.up if st.node_at(joint) > st.node_at(behind) else Direction.down
+        return any(s.direction is towards for s in st.signals_at(joint))
 
     def _leads_onto(self, track: str, node_from: str, tracks: set[str]) -> bool:
         """Does a movement leaving ``node_from`` along ``track`` reach one of ``tracks`` before another turnout
@@ -187,8 +192,8 @@ class _Builder:
         ``end_node``: the movement goes on to the next signal of its own direction, the station limit, an end, or
         into a station track or spur at sight, whichever way the turnouts beyond lie."""
         st = self.st
-        if end_node not in st.joints:
-            return None, ()
+        if end_node not in st.joints or any(s.direction is d for s in st.signals_at(end_node)):
+            return None, ()  # the end of the network, or a signal of its own direction stops it there
         first = st.entry_track(end_node, d)
         if st.sections[st.tracks[first].section].role in _AT_SIGHT:
             return st.tracks[first].section, ()

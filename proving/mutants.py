@@ -103,7 +103,8 @@ def _approach_one_section(s: ExitStack) -> None:
 
 
 def _no_conflict_table(s: ExitStack) -> None:
-    _patch(s, conflicts, "_collapse", lambda routes, variants, found, head_on: None)
+    _patch(s, conflicts, "_bulk", lambda routes, en, simple: None)
+    _patch(s, conflicts, "_with_run_on", lambda routes, en: None)
 
 
 # ---- the running interlocking ---------------------------------------------------------------------------------------

@@ -8,8 +8,8 @@ at both ends, entered past a home signal. In each throat:
   leads, so a train from any line can reach the groups further along (down trains from lead ``g`` to leads
   ``>= g`` at the X end, the mirror image at the S end) and every route has a single path;
 * each lead ends in a ladder of single turnouts fanning out to its group's station tracks;
-* a shunting signal stands between the crossovers and the ladder, and some leads have a shunting neck (牵出线) on a
-  turnout of its own, with a shunting signal and an end button at its buffer stop.
+* a pair of shunting signals (one each way) stands between the crossovers and the ladder, and some leads have a
+  shunting neck (牵出线) on a turnout of its own, with a shunting signal and an end button at its buffer stop.
 
 Every station track has a starting signal at each end with train and shunt buttons; every turnout lies in its own
 25 Hz section bounded by insulated joints. The number of groups is chosen so that the file has exactly
@@ -155,10 +155,12 @@ class _Builder:
             lead.nodes.append((home, None, None))
             for _, tid, low, high in sorted(lead_turnouts[g]):
                 lead.nodes.append((tid, low, high))
-            # shunting signal between the crossovers and the ladder
+            # a pair of shunting signals (并置调车信号机) between the crossovers and the ladder: one into the ladder,
+            # one for movements out of it, which stop there rather than run on over the crossovers
             dj = self.joint(f"J{end}D{g}", end, self.shunt_u)
             lead.nodes.append((dj, None, None))
             self.shunt_signal(end, dj, into)
+            self.shunt_signal(end, dj, "up" if into == "down" else "down")
             if g < self.necks[end]:
                 neck = self.turnout(end, self.shunt_u + 40.0, 9)
                 qj = self.joint(f"J{end}Q{g}", end, self.shunt_u + 15.0)

@@ -1,7 +1,8 @@
 """Flank protection (侧面防护) and fouling (侵限) demanded by a path, from the geometry alone.
 
 A movement on a path is endangered from the side by whatever can run into the path where it leaves a turnout or
-crosses a diamond. The **first turnout** met from the free leg of a path turnout (across joints, within the throat),
+crosses a diamond. The **first turnout** met from the free leg of a path turnout (across joints, within the throat,
+short of a signal that faces movements coming towards the path: that signal protects the flank),
 or from either end of a track that crosses the path at a diamond, is a flank turnout when it is met on its normal or
 reverse leg: it must lie the other way, away from the path, unless that way also leads straight into the path (as
 the other diagonal of a scissors crossover does), in which case it cannot protect and nothing is demanded of it.
@@ -16,7 +17,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
-from stations.schema import SectionRole
+from stations.schema import Direction, SectionRole
 from stations.station import Station
 
 from .authority import other
@@ -89,7 +90,8 @@ class Flank:
 
     def _first_turnout(self, track: str, node_from: str, path: set[str]) -> tuple[str, str] | None:
         """The first turnout (and the leg it is met on) walking from ``node_from`` along ``track`` and on across
-        joints, within the throat; None at an end, outside the throat, or back on the path."""
+        joints, within the throat; None at an end, outside the throat, back on the path, or at a signal that faces
+        movements coming towards the path (they stop at it: the signal protects the flank)."""
         st = self.st
         while True:
             if track in path or self.role[track] not in _WALKABLE:
@@ -99,6 +101,9 @@ class Flank:
             if far.leg is not None:
                 return far.node, far.leg
             if far.node not in st.joints:
+                return None
+            towards_path = Direction.up if st.node_at(far.node) > st.node_at(node_from) else Direction.down
+            if any(s.direction is towards_path for s in st.signals_at(far.node)):
                 return None
             lo, hi = st.joint_tracks(far.node)
             track, node_from = (hi if lo == track else lo), far.node

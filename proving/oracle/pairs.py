@@ -62,12 +62,23 @@ class PaperOracle:
 
     def configurations(self, fixed: dict[str, str], *specs: RouteSpec) -> Iterator[tuple[dict[str, str],
                                                                                           list[Authority]]]:
-        """Every way the free turnouts the authorities run over may lie, with the authorities traced over it."""
+        """Every way the free turnouts the authorities run over may lie, with the authorities traced over it. A free
+        facing turnout may lie either way; a free turnout a path runs through trailing is set the way the path
+        needs (the interlocking brings it there); two paths that need a free turnout both ways cannot be set
+        together, which shows as a turnout one path needs the other way round."""
         stack = [dict(fixed)]
         while stack:
             lies = stack.pop()
             auths = [self.tracer.trace(s.signal, s.kind, lies.get) for s in specs]
             free = next((a.broken_at for a in auths if a.end == "broken" and a.broken_at is not None), None)
+            trailing = {t: a.turnouts[t] for a in auths for t in a.against if lies.get(t) is None}
+            if free is None and trailing:  # the facing turnouts first: they lie as they lie; these follow
+                nxt = dict(lies)
+                for t, pos in trailing.items():
+                    for u in [t, *self.partners.get(t, ())]:
+                        nxt.setdefault(u, pos)
+                stack.append(nxt)
+                continue
             if free is None:
                 yield lies, auths
                 continue
@@ -105,6 +116,11 @@ class PaperOracle:
         if why:
             return why, fixed
         for lies, (a, b) in self.configurations(fixed, x, y):
+            for first, second in ((a, b), (b, a)):
+                for t in first.against:
+                    if t in second.turnouts and second.turnouts[t] != first.turnouts[t]:
+                        return (f"turnout {t}: {first.signal}'s path needs it {first.turnouts[t]}, {second.signal}'s "
+                                f"{second.turnouts[t]}" + self._when(lies, fixed)), lies
             fouling: list[set[str]] = []
             for first, second, spec in ((a, b, y), (b, a, x)):
                 demands, foul = self.flank.of(first.tracks, first.turnouts)
