@@ -88,8 +88,9 @@ class Interlocking(Engine):
                 return why
         for other, rs in self.routes.items():
             why = r.conflicts.get(other) or self._conditional(r, rs)
-            if why and self._still_conflicts(rs, r, run_on, why):
-                return f"conflicting route {other} is locked ({why})"
+            held = self._still_conflicts(rs, r, run_on) if why else ""
+            if held:
+                return f"conflicting route {other} is locked ({held})"
         sections = list(r.sections) + (list(run_on.sections) if run_on else []) + list(r.overlap_sections)
         for s in [*sections, *(f.section for f in r.fouling)]:
             for lk in self.locks.section_locks(s):
@@ -137,27 +138,31 @@ class Interlocking(Engine):
         return (r.signal == first.end_signal and r.direction is first.direction
                 and section in first.overlap_sections and section not in first.sections)
 
-    def _still_conflicts(self, rs: RouteState, r: Route, run_on: RunOn | None, why: str) -> bool:
-        """Does the active route ``rs`` still hold something ``r`` needs? Sections released behind a train are free
-        for the next route, as in a real CBI, even while the rest of the train's route is still locked. An enemy
-        that leads head-on onto a track stays one while it holds (or leads into) that track."""
+    def _still_conflicts(self, rs: RouteState, r: Route, run_on: RunOn | None) -> str:
+        """What the active route ``rs`` still holds that ``r`` needs, in a signaller's words; '' when nothing.
+        Sections released behind a train are free for the next route, as in a real CBI, even while the rest of the
+        train's route is still locked. An enemy that leads head-on onto a track stays one while it holds (or leads
+        into) that track."""
         held = {s for i, s in enumerate(rs.sections) if not rs.released[i]}
+        wanted = set(r.all_sections) | (set(run_on.sections) if run_on else set())
+        shared = sorted(wanted & (held | {f.section for f in rs.route.fouling} | set(rs.route.overlap_sections)))
+        if shared:
+            return f"section {shared[0]}"
         track = r.head_on.get(rs.id)
         if track is not None:
             theirs = rs.run_on.leads_into if rs.run_on else rs.route.leads_into
             if track in held or (theirs == track and bool(held)):
-                return True
-        wanted = set(r.all_sections) | (set(run_on.sections) if run_on else set())
-        held |= {f.section for f in rs.route.fouling} | set(rs.route.overlap_sections)
-        if wanted & held:
-            return True
+                return f"both lead onto {track} from opposite ends"
         need = {t.id: t.position for t in r.all_turnouts + (run_on.turnouts if run_on else ())}
-        if any(t.id in need and need[t.id] is not t.position and rs.id in self.locks.holders(t.id)
-               for t in rs.all_turnouts):
-            return True
+        for t in rs.all_turnouts:
+            if t.id in need and need[t.id] is not t.position and rs.id in self.locks.holders(t.id):
+                return f"turnout {t.id} {t.position.value}/{need[t.id].value}"
         crossings = self.station.crossings
-        return any(self.station.tracks[t].section in held for t in rs.route.path.tracks
-                   if any(d in r.diamonds for d, _ in crossings.get(t, ())))
+        for track_id in rs.route.path.tracks:
+            diamonds = [d for d, _ in crossings.get(track_id, ()) if d in r.diamonds]
+            if diamonds and self.station.tracks[track_id].section in held:
+                return f"diamond {diamonds[0]}"
+        return ""
 
     def approach_locked(self, rs: RouteState) -> bool:
         """接近锁闭: the signal has been open and a train is in the approach section."""
