@@ -372,3 +372,33 @@ def test_variant_buttons_become_the_via_of_the_route() -> None:
     assert out.command == "route X BA1 XI"
     assert sim.command(out.command).ok
     assert op.press(Ref("button", "XFCK", "exit")).message.startswith("XFCK is an end button")
+
+
+@run
+async def test_after_a_restart_the_sealed_power_up_release_button_asks_counts_and_puts_the_station_in_service(
+) -> None:
+    app = ConsoleApp("jiaopei", paused=True)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.press("colon", *"restart", "enter")
+        cycles(app, 2)
+        assert app.sim.section_state("7DG") == "locked" and app.sim.section_state("IG") == "locked"
+        await click(pilot, Ref("button", "X", "train"))
+        await click(pilot, Ref("button", "XI", "train"))
+        assert "上电锁闭" in message(app)  # the route is refused while the station is power-up locked
+        app.send("occupy 3G")
+        await function(pilot, "power-up")  # the sealed button acts on the whole station: it asks at once
+        assert isinstance(app.screen, ConfirmScreen) and "counter 1" in app.screen.question
+        await pilot.press("y")
+        await pilot.pause()
+        assert "3G" in message(app) and app.sim.section_state("7DG") == "locked"  # refused: a section occupied
+        app.send("vacate 3G")
+        cycles(app, 2)
+        await pilot.press("P")  # its key, a second use: the counter goes on
+        assert isinstance(app.screen, ConfirmScreen) and "counter 2" in app.screen.question
+        await pilot.press("y")
+        await pilot.pause()
+        assert app.sim.section_state("7DG") == "free" and "in service" in message(app)
+        await click(pilot, Ref("button", "X", "train"))
+        await click(pilot, Ref("button", "XI", "train"))
+        cycles(app, 40)
+        assert app.sim.aspect("X") == "U"

@@ -302,6 +302,9 @@ class ConsoleApp(App[None]):
     # ---- actions ----
     def action_arm(self, mode: str) -> None:
         out = self.operator.arm(mode)
+        if out.command:  # a button that acts on the whole station
+            self.carry_out(out)
+            return
         self.function_bar.set_armed(self.operator.mode.name if self.operator.mode else None)
         self.say(out.message or "function dropped")
         self.diagram.update_view()

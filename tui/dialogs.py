@@ -23,7 +23,7 @@ DIALOG_CSS = """
 
 
 class ConfirmScreen(ModalScreen[bool]):
-    """总人解, 区故解, 引导 and 引导总锁 are confirmed before they are sent (y / Enter yes, n / Esc no)."""
+    """总人解, 区故解, 引导, 引导总锁 and 上电解锁 are confirmed before they are sent (y / Enter yes, n / Esc no)."""
 
     DEFAULT_CSS = DIALOG_CSS.format(name="ConfirmScreen")
     BINDINGS: ClassVar[list[BindingType]] = [
@@ -112,6 +112,7 @@ Function button (bottom bar or key), then the signal / turnout / section:
   g 引导 guide           G 引导总锁 guide lock  o 重开 reopen
   n 总定位 normal        v 总反位 reverse
   l 单锁 lock   u 单解 unlock   b 单封 block   B 解封 unblock
+  P 上电解锁 power-up release (sealed: asks at once, counted)
 Click a turnout number, a signal or a section for its menu.
 
 Arrows move the cursor, Enter presses it. Shift+arrows or the wheel

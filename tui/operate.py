@@ -7,7 +7,8 @@ refusal comes back with its reason.
 
 Function buttons (总取消, 总人解, 区故解, 引导, 引导总锁, 总定位/总反位, 单锁/单解, 单封/解封, 重开) arm a mode;
 the next press on the diagram names its target. Those a real console asks to confirm (总人解, 区故解, 引导,
-引导总锁) come back with a question for the operator.
+引导总锁) come back with a question for the operator. The sealed power-up release (上电解锁) acts on the whole station:
+pressing it asks at once, and every use is counted, as the counter beside a sealed button (铅封按钮) does.
 """
 
 from __future__ import annotations
@@ -27,9 +28,11 @@ class Mode:
     key: str
     zh: str
     en: str
-    target: str  # signal, section, turnout, throat
+    target: str  # signal, section, turnout, throat, or station (no target: the button acts at once)
     template: str
     confirm: bool = False
+    sealed: bool = False  # a sealed button (铅封): each use is counted
+    short: str = ""  # its label on a narrow function bar, when shorter than ``zh``
 
 
 MODES: dict[str, Mode] = {m.name: m for m in [
@@ -45,6 +48,8 @@ MODES: dict[str, Mode] = {m.name: m for m in [
     Mode("block", "b", "单封", "block", "turnout", "block {}"),
     Mode("unblock", "B", "解封", "unblock", "turnout", "unblock {}"),
     Mode("reopen", "o", "重开", "reopen", "signal", "reopen {}"),
+    Mode("power-up", "P", "上电解锁", "power-up release", "station", "power-up-release", True, sealed=True,
+         short="上电"),
 ]}
 
 MENUS: dict[str, tuple[str, ...]] = {
@@ -70,6 +75,7 @@ class Operator:
         self.mode: Mode | None = None
         self.start: tuple[str, str] | None = None  # (signal, train|shunt)
         self.via: list[str] = []
+        self.sealed_uses: dict[str, int] = {}  # sealed button -> times it was pressed (its counter)
 
     # ---- state shown on the diagram ----
     def pressed(self) -> set[Ref]:
@@ -103,7 +109,15 @@ class Operator:
         if self.mode is not None and self.mode.name == mode:
             self.mode = None
             return Outcome(message="")
-        self.mode = MODES[mode]
+        m = MODES[mode]
+        if m.target == "station":  # nothing to choose: it asks at once
+            self.mode = None
+            count = ""
+            if m.sealed:
+                n = self.sealed_uses[m.name] = self.sealed_uses.get(m.name, 0) + 1
+                count = f" (sealed button 铅封, counter {n})"
+            return Outcome(command=m.template, confirm=f"{m.zh} ({m.en}){count}: {m.template}?")
+        self.mode = m
         return Outcome(message=self.prompt())
 
     # ---- presses ----

@@ -170,7 +170,7 @@ class FunctionBar(Widget):
         long = [(m.name, f"{m.key}:{m.zh}") for m in MODES.values()]
         if sum(len(t) + sum(1 for c in t if ord(c) > 0x2E80) + 1 for _, t in long) <= width:
             return long
-        return [(m.name, m.zh) for m in MODES.values()]
+        return [(m.name, m.short or m.zh) for m in MODES.values()]
 
     def render(self) -> Text:
         out = Text()
