@@ -1,4 +1,4 @@
-"""Random operation of a station for the safety properties (``liansuo soak``, tests/test_safety.py).
+"""Random operation of a station for the safety properties (``liansuo soak``, tests/test_oracle.py).
 
 A :class:`StepGenerator` draws one step at a time: a console command (routes, cancel, release, reopen, guide,
 turnouts, 64D, doors), a field or instructor action (occupancy, faults and repairs), a movement, or a wait. Every step
@@ -256,6 +256,7 @@ class SoakRun:
     line_of_step: list[int] = field(default_factory=list)  # index into ``lines`` after each step
     violations: list[tuple[Violation, int]] = field(default_factory=list)  # (violation, lines up to it)
     refused: int = 0
+    hazards: dict[str, int] = field(default_factory=dict)  # property -> how often: dangers it cannot see by design
     elapsed_s: float = 0.0
     simulated_s: float = 0.0
     cycles: int = 0
@@ -299,4 +300,6 @@ def soak(station: str, steps: int, seed: int, *, cycle_s: float = 0.25, sim: Sim
     run.elapsed_s = time.perf_counter() - t0
     run.simulated_s = sim.t
     run.cycles = checker.cycles
+    for h in checker.hazards:
+        run.hazards[h.prop] = run.hazards.get(h.prop, 0) + 1
     return run

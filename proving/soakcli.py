@@ -110,7 +110,7 @@ def report(run: SoakRun, *, shrink_budget_s: float = SHRINK_BUDGET_S) -> dict[st
         out.append(entry)
     return {"station": run.station, "seed": run.seed, "steps": run.steps, "cycles": run.cycles,
             "simulated_s": round(run.simulated_s, 2), "commands": len(run.lines), "refused": run.refused,
-            "elapsed_s": round(run.elapsed_s, 2), "violations": out}
+            "elapsed_s": round(run.elapsed_s, 2), "hazards": dict(sorted(run.hazards.items())), "violations": out}
 
 
 def cmd_soak(args: argparse.Namespace) -> int:
@@ -135,6 +135,9 @@ def cmd_soak(args: argparse.Namespace) -> int:
         print(f"liansuo soak {run.station}: {run.steps} steps (seed {run.seed}), {run.cycles} cycles, "
               f"{run.simulated_s:.0f} s simulated, {len(run.lines)} commands ({run.refused} refused), "
               f"{run.elapsed_s:.1f} s")
+        if run.hazards:
+            print("hazards (dangers the interlocking cannot see by design, not violations): "
+                  + ", ".join(f"{k} {n}" for k, n in sorted(run.hazards.items())))
         for v in violations:
             print(f"VIOLATION t = {v['t']:g} s {v['property']}: {v['text']}")
             if v["reproducer"]:

@@ -20,6 +20,7 @@ def test_soak_reports_steps_and_no_violations(capsys: pytest.CaptureFixture[str]
     rep = json.loads(capsys.readouterr().out)
     assert rep["steps"] == 300 and rep["violations"] == [] and rep["cycles"] >= 300
     assert rep["station"] == "jiaopei" and rep["seed"] == 3
+    assert all(isinstance(n, int) and n > 0 for n in rep["hazards"].values())  # counted apart from violations
 
 
 def test_the_same_seed_gives_the_same_run() -> None:

@@ -3,7 +3,7 @@
 It reads the station topology and the field as it is (lamps lit, switch rails, relays, wheelsets, doors, block
 lines), traces the movement authority of every open signal and every movement under way, and judges them against
 the safety properties. It imports nothing of the interlocking but its rule data: not the table, not the route
-engine, not the aspect rules (``tests/test_oracle_independence.py`` holds it to that).
+engine, not the aspect rules (``tests/test_oracle.py`` holds it to that).
 """
 
 from .authority import Authority, Tracer
