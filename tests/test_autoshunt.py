@@ -1,4 +1,5 @@
-"""Automatic shunting control logic (seeds 000 and 002): conditions, emergency stops, priorities, depot limits."""
+"""Automatic shunting control logic (Liu Huawei et al. 2021, Liu Jing et al. 2025: docs/sources.md): conditions,
+emergency stops, priorities, depot limits."""
 
 from __future__ import annotations
 

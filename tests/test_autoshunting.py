@@ -1,5 +1,6 @@
-"""Automatic shunting in the depot (seeds 000 and 002): each driving condition holds the locomotive braked with its
-reason; emergency stops by source; manual override; the boundary, blue signals and the depot limits."""
+"""Automatic shunting in the depot (Liu Huawei et al. 2021, Liu Jing et al. 2025: docs/sources.md): each driving
+condition holds the locomotive braked with its reason; emergency stops by source; manual override; the boundary, blue
+signals and the depot limits."""
 
 from __future__ import annotations
 

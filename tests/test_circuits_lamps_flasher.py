@@ -1,4 +1,4 @@
-"""Signal lamps with DJ proving, and the USU flasher (seed 004 lines 635-812, DOMAIN.md section 2)."""
+"""Signal lamps with DJ proving, and the USU flasher (Chen Xinmei 2023, docs/sources.md; DOMAIN.md section 2)."""
 
 from __future__ import annotations
 
@@ -184,7 +184,7 @@ def test_first_pick_up_is_slower_than_steady_flashing() -> None:
     f = RelayFlasher()
     f.energise(True)
     edges, _ = run(f, 5.0, 0.001)
-    assert edges[0] > f.dark_time_s()  # the capacitor starts empty (seed: first pick-up is the longer one)
+    assert edges[0] > f.dark_time_s()  # the capacitor starts empty (Chen Xinmei: first pick-up is the longer one)
 
 
 def test_bad_contact_classic_flasher_stays_healthy_with_the_lamp_dark() -> None:

@@ -1,4 +1,5 @@
-"""Speed and distance measurement (seed 001): the tacho formula, slip and slide detection, compensation, corrections."""
+"""Speed and distance measurement (Liu Bin et al., docs/sources.md): the tacho formula, slip and slide detection,
+compensation, corrections."""
 
 from __future__ import annotations
 

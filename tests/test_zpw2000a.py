@@ -1,5 +1,5 @@
-"""ZPW-2000A transmission-line model: DOMAIN.md figures, the seed's capacitor-fault trends (seed 004, lines
-3641-3887), the vectorised sweep against single evaluations, hysteresis, faults, and ``liansuo zpw``."""
+"""ZPW-2000A transmission-line model: DOMAIN.md figures, the capacitor-fault trends of Luo Ying 2023
+(docs/sources.md), the vectorised sweep against single evaluations, hysteresis, faults, and ``liansuo zpw``."""
 
 from __future__ import annotations
 
@@ -34,21 +34,21 @@ from stations.library import bundled
 from stations.loader import load, load_text
 
 P = DEFAULT_PARAMS
-# Seed 004 tables 1 (open) and 2 (-50 %), over every carrier: the largest fall / rise in percent.
-SEED_ADJUSTMENT_FALL = {"open": (11.6, 23.8, 18.9, 20.3), "half": (4.0, 9.0, 8.0, 9.3)}  # 客专, 普速, 站内 x2
-SEED_CAB_FALL = {"open": (19.3, 24.5, 21.5, 38.4), "half": (4.1, 0.6, 4.6, 38.4)}
-SEED_RESIDUAL_RISE = {"open": (30.3, 31.7, 41.7, 26.0), "half": (15.3, 19.0, 26.6, 17.6)}
+# Luo Ying 2023 (docs/sources.md) tables 1 (open) and 2 (-50 %), over every carrier: the largest fall / rise in percent.
+PAPER_ADJUSTMENT_FALL = {"open": (11.6, 23.8, 18.9, 20.3), "half": (4.0, 9.0, 8.0, 9.3)}  # 客专, 普速, 站内 x2
+PAPER_CAB_FALL = {"open": (19.3, 24.5, 21.5, 38.4), "half": (4.1, 0.6, 4.6, 38.4)}
+PAPER_RESIDUAL_RISE = {"open": (30.3, 31.7, 41.7, 26.0), "half": (15.3, 19.0, 26.6, 17.6)}
 
 
 @pytest.fixture(scope="module")
 def long_line() -> SweepResult:
-    """The seed's open-line case: 1400 m, every carrier, design ballast, every single capacitor fault."""
+    """Luo Ying's open-line case: 1400 m, every carrier, design ballast, every single capacitor fault."""
     return sweep([1400.0])[0]
 
 
 @pytest.fixture(scope="module")
 def station_track() -> SweepResult:
-    """The seed's station case: 650 m."""
+    """Luo Ying's station case: 650 m."""
     return sweep([650.0])[0]
 
 
@@ -133,18 +133,18 @@ def test_transmitter_at_the_lower_end_mirrors_the_section() -> None:
         lower.adjustment(ZpwFaults(capacitors={4: "open"})).voltage_mV)
 
 
-# ---- the seed's capacitor-fault trends ---------------------------------------------------------------------------
-def test_open_capacitor_lowers_the_adjustment_like_the_seed(long_line: SweepResult) -> None:
+# ---- Luo Ying's capacitor-fault trends ---------------------------------------------------------------------------
+def test_open_capacitor_lowers_the_adjustment_like_the_paper(long_line: SweepResult) -> None:
     fall = -changes(long_line, "open", "adjustment")
-    assert (fall > 0).all()  # open line: the adjustment voltage only falls (seed: 客专 and 普速 columns)
-    assert min(SEED_ADJUSTMENT_FALL["open"][:2]) - 2 <= fall.max() <= max(SEED_ADJUSTMENT_FALL["open"]) + 5
+    assert (fall > 0).all()  # open line: the adjustment voltage only falls (Luo Ying: 客专 and 普速 columns)
+    assert min(PAPER_ADJUSTMENT_FALL["open"][:2]) - 2 <= fall.max() <= max(PAPER_ADJUSTMENT_FALL["open"]) + 5
     assert fall.min() < 10.0  # some capacitors matter much less than others
 
 
 def test_half_capacitance_is_the_same_trend_but_milder(long_line: SweepResult) -> None:
     half, open_ = -changes(long_line, "half", "adjustment"), -changes(long_line, "open", "adjustment")
     assert (half > 0).all() and (half < open_).all()
-    assert 2.0 <= half.max() <= max(SEED_ADJUSTMENT_FALL["half"]) + 2
+    assert 2.0 <= half.max() <= max(PAPER_ADJUSTMENT_FALL["half"]) + 2
     assert np.abs(changes(long_line, "half", "cab")).max() < np.abs(changes(long_line, "open", "cab")).max()
 
 
@@ -152,24 +152,24 @@ def test_shunt_residual_moves_but_stays_under_the_drop_threshold(long_line: Swee
                                                                 station_track: SweepResult) -> None:
     for result in (long_line, station_track):
         healthy = [k for k, f in enumerate(result.faults) if not f or next(iter(f.values())) != "short"]
-        assert result.max_shunt_residual_mV[:, :, healthy].max() < P.drop_mV  # seed: all under 153 mV
+        assert result.max_shunt_residual_mV[:, :, healthy].max() < P.drop_mV  # Luo Ying: all under 153 mV
         for mode in ("open", "half"):
             change = changes(result, mode, "residual")
-            assert change.max() <= max(SEED_RESIDUAL_RISE[mode]) + 5
+            assert change.max() <= max(PAPER_RESIDUAL_RISE[mode]) + 5
             assert change.min() >= -40.0
 
 
 def test_cab_current_changes_by_tens_of_percent(long_line: SweepResult, station_track: SweepResult) -> None:
     for result in (long_line, station_track):
         change = changes(result, "open", "cab")
-        assert min(SEED_CAB_FALL["open"]) - 5 <= np.abs(change).max() <= max(SEED_CAB_FALL["open"]) + 7
+        assert min(PAPER_CAB_FALL["open"]) - 5 <= np.abs(change).max() <= max(PAPER_CAB_FALL["open"]) + 7
         assert change.min() < -15.0
 
 
-def test_station_track_adjustment_falls_like_the_seed(station_track: SweepResult) -> None:
+def test_station_track_adjustment_falls_like_the_paper(station_track: SweepResult) -> None:
     fall = -changes(station_track, "open", "adjustment")
-    assert 10.0 <= fall.max() <= max(SEED_ADJUSTMENT_FALL["open"][2:]) + 5
-    assert -changes(station_track, "half", "adjustment").max() <= max(SEED_ADJUSTMENT_FALL["half"][2:]) + 2
+    assert 10.0 <= fall.max() <= max(PAPER_ADJUSTMENT_FALL["open"][2:]) + 5
+    assert -changes(station_track, "half", "adjustment").max() <= max(PAPER_ADJUSTMENT_FALL["half"][2:]) + 2
 
 
 def test_a_shorted_capacitor_is_a_red_band(long_line: SweepResult) -> None:

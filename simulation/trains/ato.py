@@ -1,4 +1,5 @@
-"""Platform stop with door linkage (seed 003): train doors and platform screen doors open and close together.
+"""Platform stop with door linkage (Xu Yue et al., docs/sources.md): train doors and platform screen doors open and
+close together.
 
 Once the train has stopped in the stopping window, the door-open permission for the platform side is given and the
 open command goes to the screen doors through the interlocking (KMJ with ZCKJ); after the dwell both close (GMJ);

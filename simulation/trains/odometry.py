@@ -1,4 +1,4 @@
-"""Speed and distance measurement of a shunting locomotive (测速测距), after seed 001.
+"""Speed and distance measurement of a shunting locomotive (测速测距), after Liu Bin et al. (docs/sources.md).
 
 The tacho (光电速度传感器) turns wheel revolutions into pulses; over a sampling time ``t`` with ``n`` pulses the speed
 is ``v = pi * d * n / (N * t)`` (``d`` wheel diameter, ``N`` pulses per revolution). A wheel that spins (空转, slip)
@@ -10,7 +10,7 @@ absolute position (``correct``); so does a track section in the direction of tra
 (``section_transition``). An error made in the last section before a stopping point cannot be corrected any more,
 and a slide there leaves the measured position short of the true one: the dangerous side.
 
-``simulate_run`` scripts a run with a slip while accelerating and a slide while braking, seed 001's test runs.
+``simulate_run`` scripts a run with a slip while accelerating and a slide while braking, the test runs of Liu Bin et al.
 """
 
 from __future__ import annotations
@@ -44,11 +44,11 @@ class Odometer:
     """Tacho odometry with slip/slide detection and compensation.
 
     ``wheel_diameter_m`` and ``pulses_per_rev`` as for a shunting locomotive; ``a_max`` / ``a_min`` (m/s2) are the
-    slip and slide thresholds (the seed leaves them configurable: above what the locomotive can do on the steepest
+    slip and slide thresholds (Liu Bin et al. leave them configurable: above what the locomotive can do on the steepest
     gradient); ``window_s`` the time over which the tacho speed ``pi d n / (N t)`` and its acceleration are taken;
     an episode ends when the tacho agrees with the estimate for ``recover_s`` (within ``recover_tol_ms`` plus
-    ``drift_ms2`` per second of compensation, for the accelerometer's drift), or after ``max_compensation_s`` (the
-    seed's n_max). ``compensate=False`` gives the plain odometer that trusts the wheel.
+    ``drift_ms2`` per second of compensation, for the accelerometer's drift), or after ``max_compensation_s`` (n_max
+    in Liu Bin et al.). ``compensate=False`` gives the plain odometer that trusts the wheel.
     ``position_m`` is the running position along the movement's path, increasing as the locomotive runs.
     """
 
