@@ -34,17 +34,25 @@ class BlockLink:
     accidents: int = 0  # the accident button is counted, as on the real console
 
     # ---- operator actions: return (refusal or '', pulse to send or '') ------------------------------------------
-    def operate(self, action: str) -> tuple[str, str]:
+    def operate(self, action: str, section_clear: bool = True) -> tuple[str, str]:
+        """``section_clear``: the departure section's track relay is up. A block is requested or accepted only
+        with it clear: a train (or a fault) there would meet the one the block lets onto the line."""
         s = self.state
+        occupied = (f"block line {self.id}: departure section {self.departure_section} shows occupied; the block "
+                    "is given only with the line's track circuit clear")
         if action == "request":
             if s is not BlockState.idle:
                 return (f"block line {self.id} is not clear ({s.value}); a request needs the line in its normal "
                         "state"), ""
+            if not section_clear:
+                return occupied, ""
             self.state = BlockState.requested
             return "", REQUEST
         if action == "accept":
             if s is not BlockState.asked:
                 return f"block line {self.id}: the neighbour has not asked to send a train ({s.value})", ""
+            if not section_clear:
+                return occupied, ""
             self.state = BlockState.accepted
             return "", ACCEPT
         if action == "cancel":

@@ -330,6 +330,8 @@ class Engine:
             link = self.links[r.exit_link]
             if link.state.value != "permitted":
                 return f"block line {link.id} has not been accepted by the neighbour station (64D: {link.state.value})"
+            if not self.clear(link.departure_section):
+                return f"departure section {link.departure_section} is occupied"
         if r.exit_link in self.auto_links:
             why = self.against_running(r.exit_link)
             if why:

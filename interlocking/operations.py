@@ -471,7 +471,7 @@ class Interlocking(Engine):
             names = ", ".join(sorted(self.links)) or "none"
             return Result.refuse(f"there is no 64D block line '{link}' (64D lines: {names})")
         before = bl.state
-        why, pulse = bl.operate(action)
+        why, pulse = bl.operate(action, self.clear(bl.departure_section))
         if why:
             return Result.refuse(why)
         if pulse:

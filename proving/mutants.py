@@ -16,6 +16,7 @@ from typing import Any
 from unittest import mock
 
 import interlocking.autoblock as autoblock
+import interlocking.block64d as block64d
 import interlocking.conflicts as conflicts
 import interlocking.derive as derive
 import interlocking.engine as engine
@@ -212,6 +213,14 @@ def _no_64d_check(s: ExitStack) -> None:
     _wrap(s, engine.Engine, "_liaison_blocker", liaison)
 
 
+def _block_over_occupied_line(s: ExitStack) -> None:
+    def blind(real: Any) -> Any:
+        def careless(self: Any, action: str, section_clear: bool = True) -> tuple[str, str]:
+            return real(self, action, True)  # type: ignore[no-any-return]
+        return careless
+    _wrap(s, block64d.BlockLink, "operate", blind)
+
+
 def _against_running_allowed(s: ExitStack) -> None:
     _patch(s, engine.Engine, "against_running", lambda self, link: "")
 
@@ -302,6 +311,8 @@ MUTANTS: tuple[Mutant, ...] = (
     Mutant("deaf-to-flash-check", "USU is kept with the flasher's check relay down", _deaf_to_flash_check),
     Mutant("deaf-to-doors", "signals open with screen doors open", _deaf_to_doors),
     Mutant("no-64d-acceptance", "a 64D departure opens without the neighbour's acceptance", _no_64d_check),
+    Mutant("64d-block-over-occupied-line", "a 64D block is given with the line's departure section occupied",
+           _block_over_occupied_line),
     Mutant("against-running-direction", "a departure against a line's running direction opens without 改方",
            _against_running_allowed),
     Mutant("guide-stays-open", "the guide aspect stays lit after the guided train has entered", _guide_stays_open),

@@ -13,6 +13,7 @@ from __future__ import annotations
 import random
 import time
 from dataclasses import dataclass, field
+from pathlib import Path
 
 from interlocking.aspects import is_open
 from interlocking.table import Route
@@ -249,9 +250,10 @@ class StepGenerator:
 
 @dataclass
 class SoakRun:
-    station: str
+    station: str  # the station's id
     seed: int
     steps: int
+    source: str = ""  # what loads it again: a bundled name, or the station file's absolute path
     lines: list[str] = field(default_factory=list)  # the whole run as command lines
     line_of_step: list[int] = field(default_factory=list)  # index into ``lines`` after each step
     violations: list[tuple[Violation, int]] = field(default_factory=list)  # (violation, lines up to it)
@@ -268,7 +270,8 @@ def soak(station: str, steps: int, seed: int, *, cycle_s: float = 0.25, sim: Sim
     sim = sim or Simulation(station, cycle_s=cycle_s)
     checker = Watch(sim)
     gen = StepGenerator(sim, random.Random(seed))
-    run = SoakRun(sim.station.id, seed, steps)
+    path = Path(station)
+    run = SoakRun(sim.station.id, seed, steps, str(path.resolve()) if path.suffix in (".yaml", ".yml") else station)
     pending = 0  # cycles run since the last line
     ms = round(sim.cycle_s * 1000)
 

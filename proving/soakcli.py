@@ -90,11 +90,11 @@ def annotate_refusals(station: str, lines: list[str], cycle_s: float = 0.25) -> 
 def reproducer(run: SoakRun, v: Violation, lines: list[str]) -> str:
     import yaml
 
-    lines = annotate_refusals(run.station, merge_runs(lines))
+    lines = annotate_refusals(run.source, merge_runs(lines))
 
     head = (f"# liansuo soak {run.station} --seed {run.seed}: at t = {v.t:g} s, {v.prop}: {v.text}\n"
             f"# Replays with the safety oracle on: 'liansuo test FILE' fails at the step where it happens.\n")
-    body = {"station": run.station, "safety": True,
+    body = {"station": run.source, "safety": True,
             "tests": [{"name": f"soak seed {run.seed}: {v.prop} {v.key.partition(':')[2]}", "steps": lines}]}
     return head + yaml.safe_dump(body, allow_unicode=True, sort_keys=False, width=200)
 
@@ -106,7 +106,7 @@ def report(run: SoakRun, *, shrink_budget_s: float = SHRINK_BUDGET_S) -> dict[st
         entry: dict[str, object] = {**v.as_dict(), "line": n, "reproducer": None}
         if v.key not in done and len(done) < MAX_REPRODUCERS:
             done.add(v.key)
-            entry["reproducer"] = reproducer(run, v, shrink(run.station, run.lines[:n], v.key, shrink_budget_s))
+            entry["reproducer"] = reproducer(run, v, shrink(run.source, run.lines[:n], v.key, shrink_budget_s))
         out.append(entry)
     return {"station": run.station, "seed": run.seed, "steps": run.steps, "cycles": run.cycles,
             "simulated_s": round(run.simulated_s, 2), "commands": len(run.lines), "refused": run.refused,

@@ -105,8 +105,9 @@ class RouteTest:
                        f"{p.sim.turnout_state(t)[0]}, signal {r.signal} shows {p.aspect(r.signal)}", p)
 
     def liaison(self) -> None:
-        """A departure's signal stays closed without the liaison: 64D without the neighbour's acceptance, automatic
-        block with the first block section occupied; it opens once the liaison is there."""
+        """A departure's signal stays closed without the liaison: 64D without the neighbour's acceptance or with the
+        line's departure section occupied, automatic block with the first block section occupied; it opens once the
+        liaison is there."""
         r = self.r
         il_links = self.ctx.station.model.links
         link = next((lk for lk in il_links if lk.id == r.exit_link), None)
@@ -120,6 +121,17 @@ class RouteTest:
             self.check(p.closed(r.signal) and p.state(r) == "locked", "liaison",
                        f"64D departure: signal {r.signal} shows {p.aspect(r.signal)} without the neighbour's "
                        "acceptance", p)
+            # a train (or a red band) in the line's departure section: no block, the signal stays closed
+            line = link.sections[0]
+            p.do(f"occupy {line}")
+            result = p.do(f"block-line {link.id} request")
+            p.run(SETTLE_S)
+            self.check(not result.ok and p.closed(r.signal), "liaison",
+                       f"64D departure with {line} occupied: 'block-line {link.id} request' was "
+                       f"{'accepted' if result.ok else 'refused'} and {r.signal} shows {p.aspect(r.signal)}", p)
+            p.do(f"block-line {link.id} cancel")
+            p.do(f"vacate {line}")
+            p.run(1.0)
             prepare(p, r)
         elif against_running(self.ctx.station, link.id):
             # against the line's running direction: refused until the direction is changed (改方), which a line that
