@@ -74,6 +74,7 @@ class Engine:
             self.signal_by_entry.setdefault(sec, []).append(sig_id)
         self.platform_doors = {p.section: [f"{p.id}:{d.side.value}" for d in p.screen_doors]
                                for p in st.model.platforms if p.screen_doors}
+        self._throat_platforms: dict[str, list[str]] = {}  # home signal -> platform tracks bordering its throat
         self.autoblock = AutoBlock(st)
         self.codes_dirty = True
         self.blocks_dirty = False  # the automatic block signals must be evaluated again (a line's direction changed)
@@ -338,10 +339,9 @@ class Engine:
                 return why
             if self._clear_blocks(r.exit_link) == 0:
                 return f"departure section {self.auto_links[r.exit_link][0]} is occupied"
-        for sec in self._door_sections(r):
-            for key in self.platform_doors[sec]:
-                if not self.board.doors_safe(key):
-                    return f"screen doors {key} are not closed and locked (and not bypassed)"
+        why = self.doors_blocker(self._door_sections(r))
+        if why:
+            return why
         if r.end_signal is not None and self.signals[r.end_signal].red_dark:
             return f"the red lamp of {r.end_signal} is dark (红灯转移): {r.signal} must stay closed"
         return ""
@@ -357,6 +357,38 @@ class Engine:
                     "running direction")
         return (f"line {link} runs towards this station: change its direction for departures first (改方, "
                 f"'line-direction {link} out')")
+
+    def doors_blocker(self, sections: list[str]) -> str:
+        """Why screen doors at these platform tracks keep a signal closed; '' when none does."""
+        for sec in sections:
+            for key in self.platform_doors.get(sec, ()):
+                if not self.board.doors_safe(key):
+                    return f"screen doors {key} are not closed and locked (and not bypassed)"
+        return ""
+
+    def guide_only_doors(self, signal: str) -> list[str]:
+        """The platform tracks a guided train may reach from ``signal`` under guide total lock, where the
+        interlocking does not know the way (a turnout may have been trailed through): every platform track that
+        borders the throat the signal leads into, whichever way its turnouts lie."""
+        if signal not in self._throat_platforms:
+            st = self.station
+            outside = (SectionRole.station_track, SectionRole.approach, SectionRole.block, SectionRole.departure)
+            start = st.signal_entry_track(signal)
+            seen, todo, border = {start}, [start], []
+            while todo:
+                track = todo.pop()
+                for port in st.track_ports[track]:
+                    for _, nxt in st.node_tracks[port.node]:
+                        sec = st.tracks[nxt].section
+                        if nxt in seen:
+                            continue
+                        seen.add(nxt)
+                        if sec in self.platform_doors:
+                            border.append(sec)
+                        elif st.sections[sec].role not in outside:
+                            todo.append(nxt)
+            self._throat_platforms[signal] = sorted(set(border))
+        return self._throat_platforms[signal]
 
     def _door_sections(self, r: Route) -> list[str]:
         out = [s for s in r.sections if s in self.platform_doors]
@@ -478,6 +510,11 @@ class Engine:
                 return
         if not self.board.lamp_ok(r.signal, "H"):
             self.close_signal(rs, "red lamp dark: the guide aspect needs the red lamp lit", abnormal=True)
+            rs.guide = False
+            return
+        doors = self.doors_blocker(self._door_sections(r))
+        if doors:
+            self.close_signal(rs, doors, abnormal=True)
             rs.guide = False
             return
         approach_occupied = any(not self.clear(s) for s in r.approach)
@@ -606,6 +643,10 @@ class Engine:
                 del self.guide_only[sig]
                 self.out.set_aspect(sig, stop_aspect(self.station, sig))
                 self.alarm(f"closed:{sig}", f"signal {sig} closed: red lamp dark, the guide aspect needs it lit")
+            elif doors := self.doors_blocker(self.guide_only_doors(sig)):
+                del self.guide_only[sig]
+                self.out.set_aspect(sig, stop_aspect(self.station, sig))
+                self.alarm(f"closed:{sig}", f"signal {sig} closed: {doors}")
 
     # ---- signal passed at danger ------------------------------------------------------------------------------
     def _check_spad(self, became: set[str]) -> None:

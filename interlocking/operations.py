@@ -332,6 +332,9 @@ class Interlocking(Engine):
         if throat is None:
             return Result.refuse(f"no route is set from {signal} and its throat is not under guide total lock: "
                                  f"set the route first, or 'guide-lock {signal}'")
+        doors = self.doors_blocker(self.guide_only_doors(signal))
+        if doors:  # the way is not known: every platform track the signal leads to must have its doors safe
+            return Result.refuse(f"guide refused: {doors}")
         self.guide_only[signal] = self.now
         self.out.set_aspect(signal, "HB")
         self.event("signal", f"guide aspect HB on {signal} under guide total lock")

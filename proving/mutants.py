@@ -221,6 +221,10 @@ def _block_over_occupied_line(s: ExitStack) -> None:
     _wrap(s, block64d.BlockLink, "operate", blind)
 
 
+def _guide_lock_ignores_doors(s: ExitStack) -> None:
+    _patch(s, engine.Engine, "guide_only_doors", lambda self, signal: [])
+
+
 def _against_running_allowed(s: ExitStack) -> None:
     _patch(s, engine.Engine, "against_running", lambda self, link: "")
 
@@ -315,6 +319,8 @@ MUTANTS: tuple[Mutant, ...] = (
            _block_over_occupied_line),
     Mutant("against-running-direction", "a departure against a line's running direction opens without 改方",
            _against_running_allowed),
+    Mutant("guide-lock-ignores-doors", "the guide aspect under guide total lock ignores the screen doors",
+           _guide_lock_ignores_doors),
     Mutant("guide-stays-open", "the guide aspect stays lit after the guided train has entered", _guide_stays_open),
     Mutant("no-power-up-lock", "after the interlocking starts, the station is not locked", _no_power_up_lock),
     Mutant("overlap-released-at-once", "the overlap releases as soon as the train is on the receiving track",

@@ -176,6 +176,17 @@ def test_a_relay_flasher_failing_silently_is_a_hazard_an_electronic_one_is_answe
     assert electronic.violations == []
 
 
+def test_guided_movements_under_guide_total_lock_are_the_operators_to_answer_for() -> None:
+    danxian = str(ROOT / "examples" / "stations" / "danxian.yaml")
+    # under guide total lock the interlocking checks no route by design: the operator answers for both guides
+    locked = run_lines(danxian, "guide-lock X", "guide-lock S", "guide X", "guide S", "run 2s")
+    assert locked.violations == [] and any(h.prop == "shared" and "IG" in h.text for h in locked.hazards)
+    # once the throats are unlocked again, the same meeting is the interlocking's (here one that forgets enemies)
+    unlocked = run_lines("jiaopei", "guide-lock X", "guide-unlock X", "route X XI", "shunt D2 XI", "run 10s",
+                         mutant="no-head-on-enemies")
+    assert "head-on" in props(unlocked)
+
+
 # ---- the rules, stated on their own ----------------------------------------------------------------------------------
 def test_aspects_are_read_by_colour_from_the_lamps_lit() -> None:
     reader = LampReader(load_rules().lamps)

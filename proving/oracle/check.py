@@ -53,6 +53,7 @@ class InUse:
     passed: int = 0  # sections[:passed] are behind the movement
     reached_at: float | None = None  # the last path section was first occupied (starts the overlap time)
     operator: bool = False  # it was a guided movement the operator answers for (guide total lock)
+    guided: bool = False  # it entered on the guide aspect: at sight, with no overlap beyond its end
 
     @property
     def sections(self) -> list[str]:
@@ -100,13 +101,15 @@ class Oracle:
         self.was_moving: dict[str, str | None] = {}
         self.approached: set[str] = set()  # open signals whose section in rear was occupied at the last check
         self.operated: set[str] = set()  # open guide aspects the operator answers for
+        self.guide_locked: set[str] = set()  # throats (named by their home signal) under guide total lock
         self.turnout_sections_clear: dict[str, bool] = {}  # turnout sections as they were at the last check
         self.now = 0.0
 
     def busy(self) -> bool:
         """Does the next check depend on time alone: a finding waiting for the interlocking's answer, or an overlap
         held for its release time?"""
-        return bool(self.pending) or any(u.reached_at is not None and u.auth.overlap_sections for u in self.in_use)
+        return bool(self.pending) or any(u.reached_at is not None and u.auth.overlap_sections and not u.guided
+                                         for u in self.in_use)
 
     # ---- the operator's commands ----------------------------------------------------------------------------------
     def note(self, words: list[str], accepted: bool) -> None:
@@ -114,6 +117,12 @@ class Oracle:
         ``guide`` are what may open a signal that closed."""
         if accepted and len(words) >= 2 and words[0] in ("route", "shunt", "reopen", "guide"):
             self.allowed.add(words[1])
+        if accepted and len(words) >= 2 and words[0] == "guide-lock":
+            self.guide_locked.add(words[1])
+        elif accepted and len(words) >= 2 and words[0] == "guide-unlock":
+            self.guide_locked.discard(words[1])
+        elif accepted and words[:1] == ["restart"]:
+            self.guide_locked.clear()
 
     # ---- one check ---------------------------------------------------------------------------------------------------
     def check(self, view: FieldView, now: float, showing: Iterable[str]) -> list[Finding]:
@@ -164,7 +173,7 @@ class Oracle:
             rear = self.rear[sig]
             entered = rear is None or sig in self.approached or not view.clear(rear)
             if entered and not view.clear(a.sections[0]):
-                self._start_in_use(a, view, sig in self.operated)
+                self._start_in_use(a, view, sig in self.operated, guided=self.shown[sig] == "HB")
             self.operated.discard(sig)
             if self.kind[sig] is not SignalKind.block:
                 self.closed.add(sig)
@@ -211,9 +220,11 @@ class Oracle:
         demands, fouling = self.flank.of(a.tracks, a.turnouts)
         h = _Held(sig, a, set(a.all_sections), set(a.sections), set(a.overlap_sections), set(a.diamonds),
                   set(fouling))
-        # guide total lock (引导总锁闭) exists for a throat whose turnouts lost their indication: the operator has
-        # checked them by sight and answers for the guided route; what the oracle finds on it is a hazard
-        h.operator = guide and (a.end == "broken" or any(view.proven(t) != p for t, p in a.turnouts.items()))
+        # a guide aspect over turnouts without indication, or under guide total lock (引导总锁闭, where the
+        # interlocking checks no route by design): the operator has checked the way by sight and answers for the
+        # guided route; what the oracle finds on it is a hazard
+        h.operator = guide and (a.end == "broken" or sig in self.guide_locked
+                                or any(view.proven(t) != p for t, p in a.turnouts.items()))
         if h.operator:
             self.operated.add(sig)
         else:
@@ -235,7 +246,7 @@ class Oracle:
                     h.unsettled = True
         for t, d in demands.items():
             h.needed.setdefault(t, (d.position, "flank"))
-            self._flank_turnout(sig, aspect, d, guide, view, found)
+            self._flank_turnout(sig, aspect, d, guide, view, found, h.operator)
         if not guide:
             self._clear(sig, aspect, a, fouling, view, found)
         self._doors(sig, aspect, a, view, found)
@@ -287,11 +298,11 @@ class Oracle:
             return True
         if not view.locked(t):
             found[key] = Finding(key, "turnout", f"signal {sig} shows {aspect} but turnout {t} ({role}, {pos}) is "
-                                 "not locked", delayed=True)
+                                 "not locked", hazard=operator, delayed=True)
         return False
 
     def _flank_turnout(self, sig: str, aspect: str, d: Demand, guide: bool, view: FieldView,
-                       found: dict[str, Finding]) -> None:
+                       found: dict[str, Finding], operator: bool = False) -> None:
         key = f"flank:{sig}:{d.turnout}"
         rails = view.rails(d.turnout)
         if not guide and (rails != d.position or view.proven(d.turnout) != d.position):
@@ -300,7 +311,7 @@ class Oracle:
                                  f"{where}; it must lie {d.position}, proven ({d.why})", delayed=True)
         elif not view.locked(d.turnout):
             found[key] = Finding(key, "flank", f"signal {sig} shows {aspect} but flank turnout {d.turnout} is not "
-                                 f"locked ({d.why})", delayed=True)
+                                 f"locked ({d.why})", hazard=operator, delayed=True)
 
     def _clear(self, sig: str, aspect: str, a: Authority, fouling: list[str], view: FieldView,
                found: dict[str, Finding]) -> None:
@@ -341,7 +352,7 @@ class Oracle:
                 return
 
     # ---- movements under way -----------------------------------------------------------------------------------------
-    def _start_in_use(self, a: Authority, view: FieldView, operator: bool = False) -> None:
+    def _start_in_use(self, a: Authority, view: FieldView, operator: bool = False, guided: bool = False) -> None:
         secs = a.sections
         seen = [not view.clear(s) for s in secs]
         # sections occupied beyond a clear one were occupied before the movement got there (a red band)
@@ -350,7 +361,8 @@ class Oracle:
         while k < len(secs) and seen[k]:
             k += 1
         pre = {i for i in range(k, len(secs)) if seen[i]}
-        self.in_use.append(InUse(a, [bool(v) and i not in pre for i, v in enumerate(seen)], pre, operator=operator))
+        self.in_use.append(InUse(a, [bool(v) and i not in pre for i, v in enumerate(seen)], pre, operator=operator,
+                                 guided=guided))
 
     def _in_use(self, view: FieldView) -> list[_Held]:
         out: list[_Held] = []
@@ -377,7 +389,7 @@ class Oracle:
                     u.passed += 1
                     continue
                 break
-            overlap_held = bool(a.overlap_sections) and (
+            overlap_held = not u.guided and bool(a.overlap_sections) and (
                 u.reached_at is None
                 or self.now - u.reached_at < a.overlap_release_s - (self.reaction + 1) * self.cycle_s)
             remaining = secs[u.passed:]

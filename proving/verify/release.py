@@ -260,6 +260,18 @@ class ReleaseChecks:
             return
         loose = [t.id for t in r.all_turnouts if not p.sim.turnout_state(t.id)[1]]
         self.rt.check(not loose, "guide", f"turnouts not locked under the guide aspect: {', '.join(loose)}", p)
+        doors = self.door_platforms()
+        if doors:  # the guide aspect checks the screen doors like any other: a door failing closes it
+            q = Probe(self.ctx)
+            if self.rt.opened(q, "opens"):
+                q.do(f"occupy {faulty}")
+                q.run(1.0)
+                q.do(f"guide {r.signal}")
+                q.run(1.0)
+                q.do(f"fault psd-stuck {doors[0]}")
+                q.run(1.0)
+                self.rt.check(q.aspect(r.signal) != "HB", "guide", f"screen door of {doors[0]} failed open under "
+                              f"the guide aspect: {r.signal} still shows HB", q)
         for a in r.approach:
             p.do(f"occupy {a}")
         p.run(1.0)
@@ -421,7 +433,38 @@ def throat_checks(ctx: Context) -> None:
             ctx.record(result.ok and p.aspect(throat) == "HB", "guide-lock", subject,
                        f"'guide {throat}' under guide total lock: {result.message}; the signal shows "
                        f"{p.aspect(throat)}", p)
+            for pl in _bordering_platforms(ctx, throat):
+                # the way is not known under guide total lock: a door failing at any platform the throat leads
+                # to closes the guide aspect, and it cannot be given again while the door is open
+                p.do(f"fault psd-stuck {pl}")
+                p.run(1.0)
+                again = p.do(f"guide {throat}")
+                ctx.record(p.aspect(throat) != "HB" and not again.ok, "guide-lock", subject,
+                           f"screen door of {pl} failed open under guide total lock: {throat} shows "
+                           f"{p.aspect(throat)}, 'guide {throat}' {'accepted' if again.ok else 'refused'}", p)
+                p.do(f"repair psd-stuck {pl}")
+                p.run(1.0)
             p.do(f"cancel {throat}")
         result = p.do(f"guide-unlock {throat}")
         loose = result.ok and not any(p.sim.turnout_state(t)[1] for t in turnouts)
         ctx.record(loose, "guide-lock", subject, f"'guide-unlock {throat}': {result.message}", p)
+
+
+def _bordering_platforms(ctx: Context, signal: str) -> list[str]:
+    """Platforms with screen doors whose track borders the throat ``signal`` leads into (the throat: the tracks
+    reached from the signal without entering a station track or the line), found on the track layout."""
+    st = ctx.station
+    inner = {"throat", "spur"}
+    start = st.signal_entry_track(signal)
+    seen, todo, touched = {start}, [start], set()
+    while todo:
+        for port in st.track_ports[todo.pop()]:
+            for _, nxt in st.node_tracks[port.node]:
+                if nxt in seen:
+                    continue
+                seen.add(nxt)
+                sec = st.tracks[nxt].section
+                touched.add(sec)
+                if st.sections[sec].role.value in inner:
+                    todo.append(nxt)
+    return [pl.id for pl in st.model.platforms if pl.screen_doors and pl.section in touched]
