@@ -1,4 +1,4 @@
-"""Platform screen doors (站台门) and their interface relays (DOMAIN.md section 5; Yu Qinlong 2023, docs/sources.md).
+"""Platform screen doors (站台门) and their interface relays (Yu Qinlong 2023, docs/references.md).
 
 Interlocking -> doors: ZCKJ (platform track occupied / authorised), KMJ (open), GMJ (close).
 Doors -> interlocking: PDKJ (all doors closed and locked), PDQCJ (interlock bypass, 互锁解除).

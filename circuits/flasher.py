@@ -2,7 +2,7 @@
 
 When a home signal shows USU, the top yellow lamp flashes 30-40 times a minute, nominally 35 (period 1.714 s,
 50 % duty). The interlocking may show USU only while the flasher proves itself healthy (flash-check relay SNJJ up);
-otherwise it falls back to UU. Chen Xinmei 2023 (docs/sources.md) describes both forms modelled here.
+otherwise it falls back to UU. Chen Xinmei 2023 (docs/references.md) describes both forms modelled here.
 
 Classic circuit (``RelayFlasher``), an equivalent model of the paper's circuit with its figures (24 V, JWXC-1700
 relays: pick-up 16.8 V, drop 3.4 V, two 850 ohm coils; R3 = 100 ohm in the pick-up coil feed):

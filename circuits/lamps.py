@@ -5,7 +5,7 @@ is lit, the filament transfer switches to the backup filament and raises the mai
 the signal keeps its aspect. With both filaments broken the lamp is dark, the lamp current stops and the DJ in
 series with it drops: that is what the interlocking sees (fail-safe: a dark lamp reads as dark, never as lit).
 
-DJ figures (Chen Xinmei 2023, docs/sources.md): it works at >= 140 mA and releases at >= 40 mA, i.e. it picks up when
+DJ figures (Chen Xinmei 2023, docs/references.md): it works at >= 140 mA and releases at >= 40 mA, i.e. it picks up when
 the lamp current reaches 140 mA and drops when the current falls below 40 mA; in between it keeps its state
 (hysteresis), which is what holds it up through the dim phase of a flashing lamp. Lamp currents are modelled values for
 a 12 V 25 W lamp fed from a lighting transformer, measured in the DJ circuit.

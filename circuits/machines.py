@@ -2,8 +2,8 @@
 
 A drive command starts the motor; the switch rails arrive after the machine's throw time if the switching resistance
 is within the rated force, and lock; only a locked turnout in an end position gives an indication (DBJ normal,
-FBJ reverse). Faults (switching resistance and the 4 mm obstruction test: Liu Zhenhua 2023 (docs/sources.md);
-insulation burning: the S700K insulation-burning article, 2023 (docs/sources.md)):
+FBJ reverse). Faults (switching resistance and the 4 mm obstruction test: Liu Zhenhua 2023 (docs/references.md);
+insulation burning: the S700K insulation-burning article, 2023 (docs/references.md)):
 
 - ``obstruction``: something of ``mm`` (>= 4 mm) between switch rail and stock rail: the rails cannot close and lock,
   so no indication at either end;

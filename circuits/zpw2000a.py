@@ -60,7 +60,7 @@ class ZpwParams:
     """Physical parameters; per-carrier tuples are in the order 1700, 2000, 2300, 2600 Hz. Sources: docs/zpw2000a.md.
     """
 
-    # line (typical ZPW-2000A design values, 60 kg/m jointless rail; not given by Luo Ying 2023 (docs/sources.md):
+    # line (typical ZPW-2000A design values, 60 kg/m jointless rail; not given by Luo Ying 2023 (docs/references.md):
     # verify)
     rail_resistance_ohm_km: tuple[float, float, float, float] = (1.177, 1.306, 1.435, 1.558)
     rail_inductance_mH_km: tuple[float, float, float, float] = (1.314, 1.304, 1.297, 1.291)
@@ -68,7 +68,7 @@ class ZpwParams:
     # compensation capacitors (typical line values; station coding uses 80/80/60/60 uF)
     capacitance_uF: tuple[float, float, float, float] = (55.0, 50.0, 46.0, 40.0)
     capacitor_spacing_m: float = 100.0  # DOMAIN.md: about every 100 m, half a spacing at the ends
-    capacitor_min_section_m: float = 300.0  # DOMAIN.md / Luo Ying 2023 (docs/sources.md): only sections over 300 m
+    capacitor_min_section_m: float = 300.0  # DOMAIN.md / Luo Ying 2023 (docs/references.md): only sections over 300 m
     capacitor_short_ohm: float = 0.01  # a shorted capacitor (modelled)
     # transmitter end (typical: level-1 output 161-170 V, 1:9 matching transformer; impedances modelled)
     transmitter_V: float = 170.0
@@ -232,7 +232,7 @@ def _capacitor_table(carriers: Sequence[str], faults: Sequence[Mapping[int, str]
 
 
 def single_faults(n: int, modes: Sequence[str] = FAULT_MODES) -> list[dict[int, str]]:
-    """No fault, then every capacitor in every mode, one at a time (Luo Ying's fault cases, docs/sources.md)."""
+    """No fault, then every capacitor in every mode, one at a time (Luo Ying's fault cases, docs/references.md)."""
     return [{}] + [{k: m} for m in modes for k in range(1, n + 1)]
 
 

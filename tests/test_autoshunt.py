@@ -1,4 +1,4 @@
-"""Automatic shunting control logic (Liu Huawei et al. 2021, Liu Jing et al. 2025: docs/sources.md): conditions,
+"""Automatic shunting control logic (Liu Huawei et al. 2021, Liu Jing et al. 2025: docs/references.md): conditions,
 emergency stops, priorities, depot limits."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Automatic shunting in the depot (Liu Huawei et al. 2021, Liu Jing et al. 2025: docs/sources.md): each driving
+"""Automatic shunting in the depot (Liu Huawei et al. 2021, Liu Jing et al. 2025: docs/references.md): each driving
 condition holds the locomotive braked with its reason; emergency stops by source; manual override; the boundary, blue
 signals and the depot limits."""
 

@@ -1,5 +1,5 @@
-"""The bundled locomotive depot (机务段, Liu Huawei et al. 2021, docs/sources.md): it loads cleanly, its table has the
-shunting routes an automatic locomotive needs, and its markers are where the depot rules expect them."""
+"""The bundled locomotive depot (机务段, Liu Huawei et al. 2021, docs/references.md): it loads cleanly, its table has
+the shunting routes an automatic locomotive needs, and its markers are where the depot rules expect them."""
 
 from __future__ import annotations
 

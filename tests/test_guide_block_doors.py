@@ -109,8 +109,9 @@ def test_flasher_failure_degrades_usu_to_uu(gaotie: Driver) -> None:
 
 
 def test_classic_relay_flasher_bad_contact_is_silent(gaotie: Driver) -> None:
-    """Chen Xinmei 2023 (docs/sources.md): with the classic RC flasher a bad SNJ contact leaves the flashing lamp dark
-    while SNJ keeps working, so the interlocking still commands USU and the signal silently shows a single yellow."""
+    """Chen Xinmei 2023 (docs/references.md): with the classic RC flasher a bad SNJ contact leaves the flashing lamp
+    dark while SNJ keeps working, so the interlocking still commands USU and the signal silently shows a single
+    yellow."""
     gaotie("route S S4", "route S4 SFCK", "run 15s", "expect signal S USU", "fault flasher S", "run 5s",
            "expect signal S USU", "expect no-alarm flasher")
     assert gaotie.sim.field.lit_lamps("S") == {"U2"}

@@ -1,4 +1,4 @@
-"""Speed and distance measurement (Liu Bin et al., docs/sources.md): the tacho formula, slip and slide detection,
+"""Speed and distance measurement (Liu Bin et al., docs/references.md): the tacho formula, slip and slide detection,
 compensation, corrections."""
 
 from __future__ import annotations

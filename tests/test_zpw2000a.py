@@ -1,5 +1,5 @@
 """ZPW-2000A transmission-line model: DOMAIN.md figures, the capacitor-fault trends of Luo Ying 2023
-(docs/sources.md), the vectorised sweep against single evaluations, hysteresis, faults, and ``liansuo zpw``."""
+(docs/references.md), the vectorised sweep against single evaluations, hysteresis, faults, and ``liansuo zpw``."""
 
 from __future__ import annotations
 
@@ -34,7 +34,8 @@ from stations.library import bundled
 from stations.loader import load, load_text
 
 P = DEFAULT_PARAMS
-# Luo Ying 2023 (docs/sources.md) tables 1 (open) and 2 (-50 %), over every carrier: the largest fall / rise in percent.
+# Luo Ying 2023 (docs/references.md) tables 1 (open) and 2 (-50 %), over every carrier: the largest fall / rise in
+# percent.
 PAPER_ADJUSTMENT_FALL = {"open": (11.6, 23.8, 18.9, 20.3), "half": (4.0, 9.0, 8.0, 9.3)}  # 客专, 普速, 站内 x2
 PAPER_CAB_FALL = {"open": (19.3, 24.5, 21.5, 38.4), "half": (4.1, 0.6, 4.6, 38.4)}
 PAPER_RESIDUAL_RISE = {"open": (30.3, 31.7, 41.7, 26.0), "half": (15.3, 19.0, 26.6, 17.6)}

@@ -1,4 +1,4 @@
-"""Platform stop with door linkage (Xu Yue et al., docs/sources.md): train doors and platform screen doors open and
+"""Platform stop with door linkage (Xu Yue et al., docs/references.md): train doors and platform screen doors open and
 close together.
 
 Once the train has stopped in the stopping window, the door-open permission for the platform side is given and the

@@ -1,4 +1,4 @@
-"""Automatic shunting (Liu Huawei et al. 2021, Liu Jing et al. 2025: docs/sources.md): the locomotive moves only
+"""Automatic shunting (Liu Huawei et al. 2021, Liu Jing et al. 2025: docs/references.md): the locomotive moves only
 while its driving conditions hold.
 
 The centre works through the shunting plan: it asks the interlocking for each planned route in turn (the same
@@ -169,7 +169,7 @@ def auto_limit(sim: Simulation, tr: Train) -> tuple[float, str] | None:
     tracks = {a.track for a in axles} | {m[0] for _, m in sim.fleet.track.moves_ahead(tr.pos, 100.0)}
     rear = axles[-1].x if axles else x
     # the limit here and the braking curves to the restricted stretches ahead (8 km/h, 3 km/h:
-    # Liu Huawei et al. 2021, docs/sources.md)
+    # Liu Huawei et al. 2021, docs/references.md)
     limit = permitted_speed_kmh(x, tr.direction.value, sim.station.model.markers, rear_m=rear, tracks=tracks,
                                 decel_ms2=tr.consist.brake_ms2) / 3.6
     why = f"depot limit {limit * 3.6:g} km/h"

@@ -1,7 +1,7 @@
 """Automatic shunting control logic (调车机车自动驾驶): conditions, emergency stops, priorities, depot limits.
 
-Pure logic, after Liu Jing et al. 2025 (docs/sources.md; control conditions and modes of automatic shunting) and
-Liu Huawei et al. 2021 (docs/sources.md; automatic shunting in a locomotive depot). Nothing here moves a train: the
+Pure logic, after Liu Jing et al. 2025 (docs/references.md; control conditions and modes of automatic shunting) and
+Liu Huawei et al. 2021 (docs/references.md; automatic shunting in a locomotive depot). Nothing here moves a train: the
 train driver of the simulation asks these functions whether it may enter automatic mode, whether it may move, what it
 must do now, how fast it may run and where it must stop.
 
@@ -20,9 +20,9 @@ from enum import StrEnum
 from typing import Any, Protocol
 
 SAFE_DISTANCE_M = 10.0  # stop this far before a closed/blue signal, the station boundary or an obstacle (typical)
-DEPOT_LIMIT_KMH = 8.0  # Liu Huawei et al. 2021 (docs/sources.md): depot speed limit
-SERVICE_LIMIT_KMH = 3.0  # Liu Huawei et al. 2021 (docs/sources.md): over sanding and washing points (and pits)
-REMOTE_LIMIT_KMH = 5.0  # Liu Jing et al. 2025 (docs/sources.md): remote driving (远程遥控) at most 5 km/h ...
+DEPOT_LIMIT_KMH = 8.0  # Liu Huawei et al. 2021 (docs/references.md): depot speed limit
+SERVICE_LIMIT_KMH = 3.0  # Liu Huawei et al. 2021 (docs/references.md): over sanding and washing points (and pits)
+REMOTE_LIMIT_KMH = 5.0  # Liu Jing et al. 2025 (docs/references.md): remote driving (远程遥控) at most 5 km/h ...
 REMOTE_LIMIT_M = 200.0  # ... and 200 m (or one signal interval)
 ONE_STOP_WINDOW_M = 5.0  # a stand this close before a one-stop point counts as the stop there (typical)
 SERVICE_DECEL_MS2 = 0.3  # braking used for the permitted-speed curve (typical for a light locomotive)
@@ -37,10 +37,10 @@ class ShuntingInputs:
     """What the automatic driving system knows now.
 
     The first ten are required: the simulation states them every cycle. The rest, also from Liu Jing et al. 2025
-    (docs/sources.md), default to "met" (not modelled, so no fault); set one to ``False`` to study that failure.
+    (docs/references.md), default to "met" (not modelled, so no fault); set one to ``False`` to study that failure.
     """
 
-    # driving conditions (行车条件), Liu Jing et al. 2025 (docs/sources.md) section 1.2 (numbers as there)
+    # driving conditions (行车条件), Liu Jing et al. 2025 (docs/references.md) section 1.2 (numbers as there)
     authorised_onboard: bool  # 1 the cab's automatic-driving switch is at "auto"
     authorised_centre: bool  # 2 the control centre's terminal is at "automatic driving"
     shunting_order: bool  # 3 a shunting order allows movement (推进/起动/减速/十车/五车/三车/连结/溜放)
@@ -55,7 +55,7 @@ class ShuntingInputs:
     system_healthy: bool = True  # 10 the automatic driving system itself is healthy
     area_ahead_ok: bool = True  # no failed non-critical ground input (gate, hand-thrown turnout) covers the area
     # entry conditions (投入条件): the crew's check (人检) and the self-check (自检), Liu Jing et al. 2025
-    # (docs/sources.md) section 1.1
+    # (docs/references.md) section 1.1
     crew_confirmed: bool = True  # positioning right, plan matches position, direction and distance right
     positioning_ok: bool = True  # satellite, RFID tag and balise positioning working
     ground_signals_ok: bool = True  # signal and yard indications received
@@ -135,9 +135,9 @@ def _who(source: str) -> str:
 class EmergencyStops:
     """Emergency stops by source: whoever set a stop releases it (谁下达，谁解锁); sources coexist independently.
 
-    Sources (Liu Jing et al. 2025, docs/sources.md): ``team`` (shunting team's radio order), ``cab`` (button in the cab
-    or on the body), ``remote`` (remote terminal), ``system`` (the automatic system itself: perception, sudden signal
-    change, service brake failure). Other source names are accepted and follow the same rule.
+    Sources (Liu Jing et al. 2025, docs/references.md): ``team`` (shunting team's radio order), ``cab`` (button in
+    the cab or on the body), ``remote`` (remote terminal), ``system`` (the automatic system itself: perception, sudden
+    signal change, service brake failure). Other source names are accepted and follow the same rule.
     """
 
     def __init__(self) -> None:
@@ -361,8 +361,8 @@ def next_stop(front_m: float, direction: str, markers: Iterable[MarkerLike], *, 
 
 class OneStopPoints:
     """One-stop points of a movement: each is served once the movement stood within ``window_m`` before it and the
-    driver confirmed the restart (再发车确认, Liu Huawei et al. 2021, docs/sources.md); until then it is the movement's
-    stopping point."""
+    driver confirmed the restart (再发车确认, Liu Huawei et al. 2021, docs/references.md); until then it is the
+    movement's stopping point."""
 
     def __init__(self, markers: Iterable[MarkerLike], *, tracks: Collection[str] | None = None,
                  window_m: float = ONE_STOP_WINDOW_M) -> None:

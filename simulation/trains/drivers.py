@@ -4,7 +4,7 @@
   interlocking notices);
 - ``signal``: stops short of a closed signal (H, A or dark) and of buffer stops, and keeps to the speed of the last
   aspect passed (U / UU / USU / HB / B ...);
-- ``auto``: automatic shunting (Liu Jing et al. 2025, docs/sources.md): moves only while the driving conditions hold,
+- ``auto``: automatic shunting (Liu Jing et al. 2025, docs/references.md): moves only while the driving conditions hold,
   stops at a safe distance before closed or blue signals and at the station boundary, keeps to the depot limits.
 """
 

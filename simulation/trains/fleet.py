@@ -28,8 +28,8 @@ SLIP_RAMP_S = 1.0
 
 @dataclass
 class PlatformStop:
-    """ATO platform stop (Xu Yue et al., docs/sources.md): stop in the window, open the doors on the platform side with
-    the screen doors, dwell, close, and leave only with the doors closed and locked."""
+    """ATO platform stop (Xu Yue et al., docs/references.md): stop in the window, open the doors on the platform side
+    with the screen doors, dwell, close, and leave only with the doors closed and locked."""
 
     platform: str
     section: str
@@ -55,9 +55,9 @@ class Train:
     train_doors_open: bool = False
     controller: object | None = None  # the automatic shunting controller, when in auto mode
     shunting: bool = False  # a shunting movement (heeds shunting signals) rather than a train movement
-    # emergency stops by source (Liu Jing et al. 2025, docs/sources.md)
+    # emergency stops by source (Liu Jing et al. 2025, docs/references.md)
     estops: EmergencyStops = field(default_factory=EmergencyStops)
-    # on-board speed and distance measurement (Liu Bin et al., docs/sources.md)
+    # on-board speed and distance measurement (Liu Bin et al., docs/references.md)
     odometer: Odometer = field(default_factory=Odometer)
     travelled_m: float = 0.0  # the true distance run since placed (what the odometer estimates)
     slip_ratio: float = 0.0  # wheel speed / true speed - 1 while an injected slip (> 0) or slide (< 0) lasts
@@ -225,7 +225,7 @@ class Fleet:
                     if aspect in ("H", "A", ""):
                         self.notify("train", f"train {tr.name} passed signal {sig.id} at {aspect or 'dark'}")
 
-    # ---- platform stop and doors (Xu Yue et al., docs/sources.md) ------------------------------------------------
+    # ---- platform stop and doors (Xu Yue et al., docs/references.md) ------------------------------------------------
     def set_platform_stop(self, tr: Train, platform: str) -> str:
         p = next((p for p in self.station.model.platforms if p.id == platform), None)
         if p is None:

@@ -1,4 +1,4 @@
-"""Speed and distance measurement of a shunting locomotive (测速测距), after Liu Bin et al. (docs/sources.md).
+"""Speed and distance measurement of a shunting locomotive (测速测距), after Liu Bin et al. (docs/references.md).
 
 The tacho (光电速度传感器) turns wheel revolutions into pulses; over a sampling time ``t`` with ``n`` pulses the speed
 is ``v = pi * d * n / (N * t)`` (``d`` wheel diameter, ``N`` pulses per revolution). A wheel that spins (空转, slip)
