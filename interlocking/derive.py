@@ -316,6 +316,8 @@ class _Builder:
         end_node = path.end
         beyond = st.tracks[st.entry_track(end_node, path.direction)].section if end_node in st.joints else None
         exit_link = self._link_beyond(end_node, path.direction) if kind == "train" and end_signal is None else None
+        line = self._line_beyond(end_node, path.direction) if kind == "train" and end_signal is None \
+            and exit_link is None else ()
         if kind == "train":
             category = "departure" if end_signal is None else (
                 "receiving" if sig.kind is SignalKind.home else "transfer")
@@ -333,7 +335,7 @@ class _Builder:
             direction=path.direction, path=path, turnouts=tuple(turnouts + extra), sections=path.sections,
             fouling=tuple(f for f in fouling if f.section not in path.sections),
             approach=self._approach(start), end_node=end_node, end_signal=end_signal, beyond=beyond,
-            exit_link=exit_link,
+            exit_link=exit_link, line_sections=line,
             overlap_sections=tuple(ov.sections) if ov else (),
             overlap_turnouts=tuple(RouteTurnout(t.turnout, t.position, "route") for t in ov.turnouts) if ov else (),
             overlap_release_s=float(ov.release_s) if ov else 0.0,
@@ -360,6 +362,26 @@ class _Builder:
                 return None
             track = self.st.entry_track(far, d)
         return None
+
+    def _line_beyond(self, node: str, d: Direction) -> tuple[str, ...]:
+        """The sections a departure runs onto past ``node`` where the file describes no block: on to the end of the
+        line, or to the next signal of its direction, without passing a turnout. The departure checks them clear,
+        since nothing else does."""
+        if node not in self.st.joints:
+            return ()
+        track: str | None = self.st.entry_track(node, d)
+        out: list[str] = []
+        while track is not None and len(out) < 50:
+            sec = self.st.tracks[track].section
+            if sec not in out:
+                out.append(sec)
+            far = self.topo.far_node((track, d))
+            if far in self.st.ends or far not in self.st.joints:
+                return tuple(out) if far in self.st.ends else ()
+            if any(s.direction is d for s in self.st.signals_at(far)):
+                break
+            track = self.st.entry_track(far, d)
+        return tuple(out)
 
     # ---- the whole table ------------------------------------------------------------------------------------
     def build(self) -> InterlockingTable:

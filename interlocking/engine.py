@@ -339,6 +339,9 @@ class Engine:
                 return why
             if self._clear_blocks(r.exit_link) == 0:
                 return f"departure section {self.auto_links[r.exit_link][0]} is occupied"
+        occupied = [sec for sec in r.line_sections if not self.clear(sec)]
+        if occupied:
+            return f"line section {occupied[0]} is occupied (no block system is described for this line)"
         why = self.doors_blocker(self._door_sections(r))
         if why:
             return why

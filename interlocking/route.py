@@ -73,6 +73,7 @@ class Route:
     end_signal: str | None  # the same-direction signal at the end of the route (the next signal)
     beyond: str | None  # the section just past the end of the route
     exit_link: str | None = None  # block link the route departs into
+    line_sections: tuple[str, ...] = ()  # a departure onto a line with no block described: its sections to the end
     overlap_sections: tuple[str, ...] = ()
     overlap_turnouts: tuple[RouteTurnout, ...] = ()
     overlap_release_s: float = 0.0
@@ -127,6 +128,7 @@ class Route:
                         "leads_into": ro.leads_into} for ro in self.run_on],
             "length_m": round(self.path.length, 1),
             "exit_link": self.exit_link,
+            "line_sections": list(self.line_sections),
             "conflicts": sorted(self.conflicts),
             "conflict_reasons": dict(sorted(self.conflicts.items())),
             "conditional_conflicts": {rid: [{"when": {t: p.value for t, p in cond}, "why": why}

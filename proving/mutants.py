@@ -225,6 +225,10 @@ def _guide_lock_ignores_doors(s: ExitStack) -> None:
     _patch(s, engine.Engine, "guide_only_doors", lambda self, signal: [])
 
 
+def _line_without_block_unchecked(s: ExitStack) -> None:
+    _patch(s, derive._Builder, "_line_beyond", lambda self, node, d: ())
+
+
 def _against_running_allowed(s: ExitStack) -> None:
     _patch(s, engine.Engine, "against_running", lambda self, link: "")
 
@@ -317,6 +321,8 @@ MUTANTS: tuple[Mutant, ...] = (
     Mutant("no-64d-acceptance", "a 64D departure opens without the neighbour's acceptance", _no_64d_check),
     Mutant("64d-block-over-occupied-line", "a 64D block is given with the line's departure section occupied",
            _block_over_occupied_line),
+    Mutant("line-without-block-unchecked", "a departure onto a line with no block described ignores the line's "
+           "track circuits", _line_without_block_unchecked),
     Mutant("against-running-direction", "a departure against a line's running direction opens without 改方",
            _against_running_allowed),
     Mutant("guide-lock-ignores-doors", "the guide aspect under guide total lock ignores the screen doors",

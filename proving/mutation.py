@@ -17,8 +17,9 @@ from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 
+from simulation.hubgen import generate_hub
 from stations.library import bundled
-from stations.loader import load
+from stations.loader import load, load_text
 from stations.station import Station
 
 from .mutants import MUTANTS, Mutant
@@ -44,13 +45,25 @@ class Caught:
                 "check": self.check, "detail": self.detail, "seconds": round(self.seconds, 2)}
 
 
+HUB = "hub:10:4"  # a small generated hub: lines with no block described, double crossovers, paired signals
+
+
 def default_stations() -> list[str]:
-    """The bundled stations, and the example stations when run from a checkout; the quickest to verify first."""
+    """The bundled stations, the example stations when run from a checkout, and a small generated hub; the quickest
+    to verify first."""
     out = sorted(bundled(), key=lambda name: (name != "jiaopei", name))
     examples = Path(__file__).resolve().parent.parent / "examples" / "stations"
     if examples.is_dir():
         out[1:1] = [str(p) for p in sorted(examples.glob("*.yaml")) if p.stem != "minimal"]
-    return out
+    return [*out, HUB]
+
+
+def load_station(spec: str) -> Station:
+    """A bundled name, a station file, or ``hub:TURNOUTS:TRACKS`` for a generated hub."""
+    if spec.startswith("hub:"):
+        turnouts, tracks = (int(x) for x in spec.split(":")[1:3])
+        return load_text(generate_hub(turnouts, tracks), f"<hub{turnouts}>")
+    return load(spec)
 
 
 def try_mutant(m: Mutant, stations: Sequence[Station], soak_steps: int = SOAK_STEPS) -> Caught:
@@ -64,7 +77,7 @@ def try_mutant(m: Mutant, stations: Sequence[Station], soak_steps: int = SOAK_ST
                 return Caught(m.name, m.what, by, st.id, f.check if by == "verify" else f.subject, f.detail,
                               time.perf_counter() - t0)
         for st in stations:
-            run = soak(st, soak_steps, 1)  # type: ignore[arg-type]
+            run = soak(st, soak_steps, 1)
             if run.violations:
                 v = run.violations[0][0]
                 return Caught(m.name, m.what, "oracle", st.id, v.prop, f"soak: {v.text}", time.perf_counter() - t0)
@@ -74,7 +87,7 @@ def try_mutant(m: Mutant, stations: Sequence[Station], soak_steps: int = SOAK_ST
 def _one(args: tuple[str, list[str], int]) -> Caught:
     name, stations, soak_steps = args
     m = next(x for x in MUTANTS if x.name == name)
-    return try_mutant(m, [load(s) for s in stations], soak_steps)
+    return try_mutant(m, [load_station(s) for s in stations], soak_steps)
 
 
 def run_mutants(stations: Iterable[str] | None = None, mutants: Iterable[Mutant] = MUTANTS,

@@ -20,6 +20,7 @@ from interlocking.table import Route
 from simulation.commands import COMMANDS
 from simulation.sim import Simulation
 from stations.schema import Direction
+from stations.station import Station
 
 from .oracle import Violation, Watch
 
@@ -264,14 +265,18 @@ class SoakRun:
     cycles: int = 0
 
 
-def soak(station: str, steps: int, seed: int, *, cycle_s: float = 0.25, sim: Simulation | None = None) -> SoakRun:
+def soak(station: str | Station, steps: int, seed: int, *, cycle_s: float = 0.25,
+         sim: Simulation | None = None) -> SoakRun:
     """Run ``steps`` random steps with the safety oracle watching; the run is kept as command lines."""
     t0 = time.perf_counter()
     sim = sim or Simulation(station, cycle_s=cycle_s)
     checker = Watch(sim)
     gen = StepGenerator(sim, random.Random(seed))
-    path = Path(station)
-    run = SoakRun(sim.station.id, seed, steps, str(path.resolve()) if path.suffix in (".yaml", ".yml") else station)
+    source = sim.station.id
+    if isinstance(station, str):
+        path = Path(station)
+        source = str(path.resolve()) if path.suffix in (".yaml", ".yml") else station
+    run = SoakRun(sim.station.id, seed, steps, source)
     pending = 0  # cycles run since the last line
     ms = round(sim.cycle_s * 1000)
 

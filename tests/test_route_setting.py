@@ -98,3 +98,19 @@ def test_squeezed_turnout_alarm_after_thirty_seconds_without_indication(jiaopei:
 def test_move_timeout(jiaopei: Driver) -> None:
     jiaopei("fault high-resistance 5", "throw 5 reverse", "run 20s", "expect alarm turnout 5 did not reach reverse",
             "expect turnout 5 none")
+
+
+def test_a_departure_onto_a_line_with_no_block_described_checks_the_line_sections() -> None:
+    from stations.library import bundled
+    from stations.loader import load_text
+
+    text = bundled()["jiaopei"].read_text(encoding="utf-8")
+    start = text.index("links:")
+    end = text.find("\n\n", start)
+    end = len(text) if end < 0 else end  # the links block runs to the next blank line, or to the end
+    d = Driver(Simulation(load_text(text[:start] + text[end:], "jiaopei-no-block.yaml")))
+    assert d.sim.table.routes["S3-X"].line_sections == ("IAG",)
+    # a train on the line, and nothing (no 64D, no automatic block) to say so but the track circuit
+    d("occupy IAG", "route S3 X", "run 20s", "expect signal S3 H", "expect route S3 X locked")
+    d("vacate IAG", "run 1s", "expect signal S3 L")
+    d("occupy IAG", "run 1s", "expect signal S3 H")  # and a train running in closes it again

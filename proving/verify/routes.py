@@ -12,9 +12,12 @@ from dataclasses import dataclass, field
 
 from interlocking.aspects import ORDER
 from interlocking.table import Route
+from stations.schema import SectionRole
 
+from ..oracle.authority import Tracer
 from .probe import Context, Probe, against_running, open_route, other, prepare, route_line, turnout_groups
 
+_LINE = (SectionRole.approach, SectionRole.departure, SectionRole.block)
 SETTLE_S = 20.0  # long enough for any turnout move (the slowest machine 6.6 s, two batches) and a 64D acceptance
 
 
@@ -112,7 +115,7 @@ class RouteTest:
         il_links = self.ctx.station.model.links
         link = next((lk for lk in il_links if lk.id == r.exit_link), None)
         if link is None:
-            self.res.not_applicable.append("liaison")
+            self.line_without_block()
             return
         p = Probe(self.ctx)
         if link.kind.value == "64d":
@@ -159,6 +162,30 @@ class RouteTest:
             p.do(f"vacate {first}")
         ok = p.until(lambda: p.state(r) == "open", SETTLE_S)
         self.check(ok, "liaison", f"signal {r.signal} did not open once the liaison was given: {p.blocker(r)}", p)
+
+    def line_without_block(self) -> None:
+        """A departure onto a line the station file gives no block system: the movement's authority (traced on the
+        layout) runs on over the line's sections, so the signal stays closed while one of them is occupied."""
+        r = self.r
+        st = self.ctx.station
+        if r.kind != "train":
+            self.res.not_applicable.append("liaison")
+            return
+        lies = {t.id: t.position.value for t in r.all_turnouts}
+        a = Tracer(st).trace(r.signal, "train", lies.get)
+        line = [s for s in a.sections if s not in r.sections and st.sections[s].role in _LINE]
+        if not line:
+            self.res.not_applicable.append("liaison")
+            return
+        p = Probe(self.ctx)
+        p.do(f"occupy {line[0]}")
+        p.do(route_line(r))
+        p.run(SETTLE_S)
+        self.check(p.closed(r.signal), "liaison", f"departure onto a line without block: signal {r.signal} shows "
+                   f"{p.aspect(r.signal)} with {line[0]} occupied", p)
+        p.do(f"vacate {line[0]}")
+        ok = p.until(lambda: p.state(r) == "open", SETTLE_S)
+        self.check(ok, "liaison", f"signal {r.signal} did not open once {line[0]} was clear: {p.blocker(r)}", p)
 
     # ---- turnouts -----------------------------------------------------------------------------------------------
     def turnout_out_of_position(self, t: str, pos: str) -> None:
