@@ -128,22 +128,22 @@ def _throw_ignores_section_locks(s: ExitStack) -> None:
     _patch(s, locks.LockLedger, "_own_locks", own)
 
 
-def _blind_to_occupancy(s: ExitStack) -> None:
+def _open_blocker_ignoring(s: ExitStack, ignored: Callable[[str], bool]) -> None:
+    """The signal opens and stays open whenever the only thing against it is a reason ``ignored`` accepts."""
     def blind(real: Any) -> Any:
         def open_blocker(self: Any, rs: RouteState, **kw: Any) -> str:
             why = real(self, rs, **kw)
-            return "" if why.endswith("is occupied") else why
+            return "" if ignored(why) else why
         return open_blocker
     _wrap(s, engine.Engine, "open_blocker", blind)
+
+
+def _blind_to_occupancy(s: ExitStack) -> None:
+    _open_blocker_ignoring(s, lambda why: why.endswith("is occupied"))
 
 
 def _blind_to_indication(s: ExitStack) -> None:
-    def blind(real: Any) -> Any:
-        def open_blocker(self: Any, rs: RouteState, **kw: Any) -> str:
-            why = real(self, rs, **kw)
-            return "" if why.startswith("turnout") else why
-        return open_blocker
-    _wrap(s, engine.Engine, "open_blocker", blind)
+    _open_blocker_ignoring(s, lambda why: why.startswith("turnout"))
 
 
 def _reopens_by_itself(s: ExitStack) -> None:

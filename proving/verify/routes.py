@@ -153,13 +153,7 @@ class RouteTest:
             if not beyond:  # the route itself runs over the line's sections to the boundary
                 self.res.not_applicable.append("liaison (the block sections are the route's own)")
                 return
-            first = beyond[0]
-            p.do(f"occupy {first}")
-            p.do(route_line(r))
-            p.run(SETTLE_S)
-            self.check(p.closed(r.signal), "liaison", f"automatic block: signal {r.signal} shows "
-                       f"{p.aspect(r.signal)} with the first block section {first} occupied", p)
-            p.do(f"vacate {first}")
+            self.closed_while_occupied(p, beyond[0], "automatic block", "the first block section")
         ok = p.until(lambda: p.state(r) == "open", SETTLE_S)
         self.check(ok, "liaison", f"signal {r.signal} did not open once the liaison was given: {p.blocker(r)}", p)
 
@@ -178,14 +172,19 @@ class RouteTest:
             self.res.not_applicable.append("liaison")
             return
         p = Probe(self.ctx)
-        p.do(f"occupy {line[0]}")
-        p.do(route_line(r))
-        p.run(SETTLE_S)
-        self.check(p.closed(r.signal), "liaison", f"departure onto a line without block: signal {r.signal} shows "
-                   f"{p.aspect(r.signal)} with {line[0]} occupied", p)
-        p.do(f"vacate {line[0]}")
+        self.closed_while_occupied(p, line[0], "departure onto a line without block", "line section")
         ok = p.until(lambda: p.state(r) == "open", SETTLE_S)
         self.check(ok, "liaison", f"signal {r.signal} did not open once {line[0]} was clear: {p.blocker(r)}", p)
+
+    def closed_while_occupied(self, p: Probe, section: str, case: str, what: str) -> None:
+        """The departure is set with ``section`` beyond it occupied: its signal stays closed; then it clears."""
+        r = self.r
+        p.do(f"occupy {section}")
+        p.do(route_line(r))
+        p.run(SETTLE_S)
+        self.check(p.closed(r.signal), "liaison", f"{case}: signal {r.signal} shows {p.aspect(r.signal)} with "
+                   f"{what} {section} occupied", p)
+        p.do(f"vacate {section}")
 
     # ---- turnouts -----------------------------------------------------------------------------------------------
     def turnout_out_of_position(self, t: str, pos: str) -> None:
@@ -224,21 +223,27 @@ class RouteTest:
         p = Probe(self.ctx)
         if not self.opened(p, "opens"):
             return
-        p.do(f"fault no-indication {t}")
+        self.closes_until_reopened(p, "no-indication", f"fault no-indication {t}", f"turnout {t} lost its indication",
+                                   f"repair no-indication {t}", f"turnout {t}'s indication came back")
+
+    def closes_until_reopened(self, p: Probe, check: str, cause: str, what: str, repair: str, repaired: str) -> None:
+        """On an open signal: ``cause`` closes it with an alarm; after ``repair`` it stays closed until the operator
+        reopens it (重复开放)."""
+        sig = self.r.signal
+        p.do(cause)
         p.run(1.0)
-        if not self.check(p.closed(r.signal), "no-indication", f"turnout {t} lost its indication: signal {r.signal} "
-                          f"still shows {p.aspect(r.signal)}", p):
+        if not self.check(p.closed(sig), check, f"{what}: signal {sig} still shows {p.aspect(sig)}", p):
             return
         self.closing_alarm(p)
-        p.do(f"repair no-indication {t}")
+        p.do(repair)
         p.run(5.0)
-        if not self.check(p.closed(r.signal), "no-automatic-reopening", f"signal {r.signal} reopened by itself "
-                          f"({p.aspect(r.signal)}) after turnout {t}'s indication came back", p):
+        if not self.check(p.closed(sig), "no-automatic-reopening", f"signal {sig} reopened by itself "
+                          f"({p.aspect(sig)}) after {repaired}", p):
             return
-        result = p.do(f"reopen {r.signal}")
+        result = p.do(f"reopen {sig}")
         p.run(1.0)
-        self.check(result.ok and p.is_open(r.signal), "reopen", f"'reopen {r.signal}' after the repair: "
-                   f"{result.message}; signal shows {p.aspect(r.signal)}", p)
+        self.check(result.ok and p.is_open(sig), "reopen", f"'reopen {sig}' after {repaired}: {result.message}; "
+                   f"signal shows {p.aspect(sig)}", p)
 
     def closing_alarm(self, p: Probe) -> None:
         """A signal closed abnormally raises an alarm (非正常关闭报警)."""
@@ -263,18 +268,5 @@ class RouteTest:
         p = Probe(self.ctx)
         if not self.opened(p, "opens"):
             return
-        p.do(f"occupy {s}")
-        p.run(1.0)
-        if not self.check(p.closed(r.signal), "section-occupied", f"section {s} occupied: signal {r.signal} still "
-                          f"shows {p.aspect(r.signal)}", p):
-            return
-        self.closing_alarm(p)
-        p.do(f"vacate {s}")
-        p.run(5.0)
-        if not self.check(p.closed(r.signal), "no-automatic-reopening", f"signal {r.signal} reopened by itself "
-                          f"({p.aspect(r.signal)}) after section {s} cleared", p):
-            return
-        result = p.do(f"reopen {r.signal}")
-        p.run(1.0)
-        self.check(result.ok and p.is_open(r.signal), "reopen", f"'reopen {r.signal}' after {s} cleared: "
-                   f"{result.message}; signal shows {p.aspect(r.signal)}", p)
+        self.closes_until_reopened(p, "section-occupied", f"occupy {s}", f"section {s} occupied", f"vacate {s}",
+                                   f"section {s} cleared")
