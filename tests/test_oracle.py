@@ -24,6 +24,7 @@ from stations.loader import load
 
 ROOT = Path(__file__).resolve().parent.parent
 SHUANGXIAN = str(ROOT / "examples" / "stations" / "shuangxian.yaml")
+DANXIAN = str(ROOT / "examples" / "stations" / "danxian.yaml")
 BROKEN = ROOT / "examples" / "broken" / "gaotie-no-diamond-protection.yaml"
 
 
@@ -70,7 +71,7 @@ def random_run(station: str, rnd: random.Random, steps: int) -> tuple[Watch, lis
     return watch, script
 
 
-@pytest.mark.parametrize("station", ["jiaopei", "gaotie", SHUANGXIAN])
+@pytest.mark.parametrize("station", ["jiaopei", "gaotie", SHUANGXIAN, DANXIAN])
 @settings(max_examples=8, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
 @given(rnd=st.randoms(use_true_random=False))
 def test_random_operation_keeps_every_safety_property(station: str, rnd: random.Random) -> None:
@@ -177,9 +178,8 @@ def test_a_relay_flasher_failing_silently_is_a_hazard_an_electronic_one_is_answe
 
 
 def test_guided_movements_under_guide_total_lock_are_the_operators_to_answer_for() -> None:
-    danxian = str(ROOT / "examples" / "stations" / "danxian.yaml")
     # under guide total lock the interlocking checks no route by design: the operator answers for both guides
-    locked = run_lines(danxian, "guide-lock X", "guide-lock S", "guide X", "guide S", "run 2s")
+    locked = run_lines(DANXIAN, "guide-lock X", "guide-lock S", "guide X", "guide S", "run 2s")
     assert locked.violations == [] and any(h.prop == "shared" and "IG" in h.text for h in locked.hazards)
     # once the throats are unlocked again, the same meeting is the interlocking's (here one that forgets enemies)
     unlocked = run_lines("jiaopei", "guide-lock X", "guide-unlock X", "route X XI", "shunt D2 XI", "run 10s",
