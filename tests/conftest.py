@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from simulation.sim import Simulation
+from liansuo.simulation.sim import Simulation
 
 
 class Driver:

@@ -10,13 +10,13 @@ from conftest import Driver
 from hypothesis import given
 from hypothesis import strategies as st
 
-from interlocking.aspects import ORDER, downgrade
-from interlocking.rules import load_rules
-from interlocking.table import build_table
-from simulation.cli import main
-from stations.library import bundled
-from stations.loader import load, load_text
-from stations.source import StationError
+from liansuo.interlocking.aspects import ORDER, downgrade
+from liansuo.interlocking.rules import load_rules
+from liansuo.interlocking.table import build_table
+from liansuo.simulation.cli import main
+from liansuo.stations.library import bundled
+from liansuo.stations.loader import load, load_text
+from liansuo.stations.source import StationError
 
 RULES = load_rules()
 ALL_LAMPS = ["L", "L2", "U", "U2", "H", "B", "A", "flasher"]
@@ -60,8 +60,8 @@ def test_red_lamp_transfer_keeps_the_signal_in_rear_closed(jiaopei: Driver) -> N
 def test_conflicts_are_symmetric_and_agree_with_the_oracle(name: str) -> None:
     """Every pair the oracle keeps apart (judged from the geometry, not from the table) is listed as conflicting,
     and no other pair is; conflicts are listed on both routes."""
-    from proving.oracle.pairs import PaperOracle
-    from proving.verify.against import spec
+    from liansuo.proving.oracle.pairs import PaperOracle
+    from liansuo.proving.verify.against import spec
 
     st = load(name)
     table = build_table(st)
@@ -136,7 +136,7 @@ def test_table_command_formats(fmt: str, capsys: pytest.CaptureFixture[str]) -> 
 
 
 def test_variant_route_by_via_button_takes_the_detour(capsys: pytest.CaptureFixture[str]) -> None:
-    from simulation.sim import Simulation
+    from liansuo.simulation.sim import Simulation
 
     table = build_table(load("gaotie"))
     v = table.routes["X-XI(BA1)"]

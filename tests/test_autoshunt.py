@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import pytest
 
-from simulation.trains.autoshunt import (
+from liansuo.simulation.trains.autoshunt import (
     PRIORITY,
     SAFE_DISTANCE_M,
     Action,
@@ -25,7 +25,7 @@ from simulation.trains.autoshunt import (
     permitted_speed_kmh,
     stop_target,
 )
-from stations.loader import load
+from liansuo.stations.loader import load
 
 CLEAR = ShuntingInputs.all_clear()
 

@@ -8,13 +8,13 @@ from collections import Counter
 
 import pytest
 
-from interlocking.table import build_table
-from simulation import bench
-from simulation.bench import Sizes, all_finite, as_text, busy_routes, run_bench
-from simulation.cli import main
-from simulation.hubgen import generate_hub
-from simulation.sim import Simulation
-from stations.loader import load_text
+from liansuo.interlocking.table import build_table
+from liansuo.simulation import bench
+from liansuo.simulation.bench import Sizes, all_finite, as_text, busy_routes, run_bench
+from liansuo.simulation.cli import main
+from liansuo.simulation.hubgen import generate_hub
+from liansuo.simulation.sim import Simulation
+from liansuo.stations.loader import load_text
 
 STATION_KEYS = {
     "station", "turnouts", "sections", "signals", "routes", "load_s", "table_build_s", "conflicting_pairs",

@@ -7,12 +7,12 @@ from typing import Any
 
 import pytest
 
-from interlocking.table import InterlockingTable, build_table
-from simulation.bench_trains import run_trains, train_slots, trains_text
-from simulation.hubgen import generate_hub
-from simulation.trains.sumo import sumo_installed
-from stations.loader import load_text
-from stations.station import Station
+from liansuo.interlocking.table import InterlockingTable, build_table
+from liansuo.simulation.bench_trains import run_trains, train_slots, trains_text
+from liansuo.simulation.hubgen import generate_hub
+from liansuo.simulation.trains.sumo import sumo_installed
+from liansuo.stations.loader import load_text
+from liansuo.stations.station import Station
 
 
 @pytest.fixture(scope="module")

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from conftest import Driver
 
-from simulation.sim import Simulation
+from liansuo.simulation.sim import Simulation
 
 
 def test_block_signal_in_rear_follows_a_cancelled_home_signal() -> None:

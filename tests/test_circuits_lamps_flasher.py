@@ -6,8 +6,8 @@ import math
 
 import pytest
 
-from circuits.flasher import ElectronicFlasher, RelayFlasher
-from circuits.lamps import Lamp, LampRelay, SignalLamps
+from liansuo.circuits.flasher import ElectronicFlasher, RelayFlasher
+from liansuo.circuits.lamps import Lamp, LampRelay, SignalLamps
 
 NOMINAL_RATE = 35.0
 

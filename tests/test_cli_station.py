@@ -10,8 +10,8 @@ import pytest
 import yaml
 from jsonschema import Draft202012Validator
 
-from simulation.cli import main
-from stations.library import bundled
+from liansuo.simulation.cli import main
+from liansuo.stations.library import bundled
 
 ROOT = Path(__file__).resolve().parent.parent
 MINIMAL = ROOT / "examples" / "stations" / "minimal.yaml"

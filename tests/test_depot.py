@@ -6,11 +6,11 @@ from __future__ import annotations
 import pytest
 from conftest import Driver
 
-from interlocking.table import build_table
-from simulation.cli import main
-from simulation.sim import Simulation
-from stations.loader import load
-from stations.schema import EndKind, Lamp, SectionRole, SignalKind
+from liansuo.interlocking.table import build_table
+from liansuo.simulation.cli import main
+from liansuo.simulation.sim import Simulation
+from liansuo.stations.loader import load
+from liansuo.stations.schema import EndKind, Lamp, SectionRole, SignalKind
 
 DEPOT_TRACKS = {"1G": "D5", "2G": "D7", "3G": "D9", "4G": "D11"}  # depot track -> the signal that leaves it
 END_BUTTONS = {"2G": "2GA", "3G": "3GA", "4G": "4GA"}

@@ -8,7 +8,7 @@ from itertools import pairwise
 import pytest
 from conftest import Driver
 
-from simulation.sim import Simulation
+from liansuo.simulation.sim import Simulation
 
 
 @pytest.fixture

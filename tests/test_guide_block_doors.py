@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 from conftest import Driver
 
-from simulation.sim import Simulation
+from liansuo.simulation.sim import Simulation
 
 
 @pytest.fixture

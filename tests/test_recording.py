@@ -7,11 +7,11 @@ from pathlib import Path
 
 import pytest
 
-from simulation import Simulation
-from simulation.cli import main
-from simulation.exercise import bundled_exercises, check_goal, parse_exercise
-from simulation.recording import FileRecorder, Recorder, RecordingError, Replayer, load_recording
-from stations.source import StationError
+from liansuo.simulation import Simulation
+from liansuo.simulation.cli import main
+from liansuo.simulation.exercise import bundled_exercises, check_goal, parse_exercise
+from liansuo.simulation.recording import FileRecorder, Recorder, RecordingError, Replayer, load_recording
+from liansuo.stations.source import StationError
 
 
 def record_session(path: Path) -> Simulation:

@@ -5,9 +5,9 @@ from __future__ import annotations
 
 from conftest import Driver
 
-from simulation.sim import Simulation
-from stations.library import bundled
-from stations.loader import load_text
+from liansuo.simulation.sim import Simulation
+from liansuo.stations.library import bundled
+from liansuo.stations.loader import load_text
 
 
 def test_sequential_release_follows_the_train_section_by_section(jiaopei: Driver) -> None:
@@ -116,7 +116,7 @@ def test_overlap_locked_with_route_and_released_180s_after_train_on_the_receivin
 
 
 def test_overlap_is_part_of_the_table_and_conflicts_only_with_movements_that_do_not_continue_it() -> None:
-    from interlocking.table import build_table
+    from liansuo.interlocking.table import build_table
 
     text = bundled()["jiaopei"].read_text(encoding="utf-8") + OVERLAP
     table = build_table(load_text(text, "jiaopei-overlap.yaml"))

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from conftest import Driver
 
-from interlocking.rules import load_rules
-from simulation.sim import Simulation
+from liansuo.interlocking.rules import load_rules
+from liansuo.simulation.sim import Simulation
 
 
 def test_receiving_route_opens_with_yellow_when_starting_signal_closed(jiaopei: Driver) -> None:
@@ -101,8 +101,8 @@ def test_move_timeout(jiaopei: Driver) -> None:
 
 
 def test_a_departure_onto_a_line_with_no_block_described_checks_the_line_sections() -> None:
-    from stations.library import bundled
-    from stations.loader import load_text
+    from liansuo.stations.library import bundled
+    from liansuo.stations.loader import load_text
 
     text = bundled()["jiaopei"].read_text(encoding="utf-8")
     start = text.index("links:")

@@ -7,7 +7,7 @@ from xml.etree import ElementTree
 
 import pytest
 
-from simulation.cli import main
+from liansuo.simulation.cli import main
 
 EXAMPLES = sorted((Path(__file__).parent.parent / "examples" / "scripts").glob("*.yaml"))
 

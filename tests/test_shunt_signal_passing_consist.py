@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from conftest import Driver
 
-from simulation.sim import Simulation
+from liansuo.simulation.sim import Simulation
 
 
 def passing() -> Driver:

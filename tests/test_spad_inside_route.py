@@ -3,7 +3,7 @@ has not passed a signal at danger; one passing the route's own closed signal has
 
 from __future__ import annotations
 
-from simulation.sim import Simulation
+from liansuo.simulation.sim import Simulation
 
 
 def run(sim: Simulation, *lines: str) -> None:

@@ -16,19 +16,19 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from pydantic import BaseModel
 
-from stations import schema
-from stations.library import bundled
-from stations.loader import load, load_text
-from stations.rules import design_rules, min_coded_length
-from stations.source import Diagnostic, StationError
-from stations.station import Station
+from liansuo.stations import schema
+from liansuo.stations.library import bundled
+from liansuo.stations.loader import load, load_text
+from liansuo.stations.rules import design_rules, min_coded_length
+from liansuo.stations.source import Diagnostic, StationError
+from liansuo.stations.station import Station
 
 ROOT = Path(__file__).resolve().parent.parent
 MINIMAL = ROOT / "examples" / "stations" / "minimal.yaml"
 DOC = ROOT / "docs" / "station-format.md"
 GLOSSARY = ROOT / "docs" / "glossary.md"
 BASE = MINIMAL.read_text(encoding="utf-8")
-JIAOPEI = (ROOT / "stations" / "library" / "jiaopei.yaml").read_text(encoding="utf-8")
+JIAOPEI = (ROOT / "liansuo" / "stations" / "library" / "jiaopei.yaml").read_text(encoding="utf-8")
 
 
 # ---- helpers ---------------------------------------------------------------------------------------------------
@@ -578,7 +578,8 @@ def test_format_doc_explains_every_key() -> None:
 
 def test_format_doc_lists_every_design_rule_and_enum_value() -> None:
     doc = DOC.read_text(encoding="utf-8")
-    for key, value in yaml.safe_load((ROOT / "stations" / "design_rules.yaml").read_text(encoding="utf-8")).items():
+    rules = ROOT / "liansuo" / "stations" / "design_rules.yaml"
+    for key, value in yaml.safe_load(rules.read_text(encoding="utf-8")).items():
         assert f"`{key}`" in doc, key
         assert f"{value:g}" in doc, (key, value)
     for enum in (schema.EndKind, schema.JointKind, schema.Machine, schema.CircuitType, schema.SectionRole,

@@ -11,11 +11,11 @@ from pathlib import Path
 import pytest
 from conftest import Driver
 
-from simulation.cli import main as cli_main
-from simulation.sim import Simulation
-from simulation.trains import sumo as sumo_module
-from simulation.trains.sumo import SumoEngine, SumoEngineError, sumo_installed
-from simulation.trains.sumo_export import (
+from liansuo.simulation.cli import main as cli_main
+from liansuo.simulation.sim import Simulation
+from liansuo.simulation.trains import sumo as sumo_module
+from liansuo.simulation.trains.sumo import SumoEngine, SumoEngineError, sumo_installed
+from liansuo.simulation.trains.sumo_export import (
     EXIT_LENGTH_M,
     SumoExportError,
     SumoUnavailable,
@@ -23,7 +23,7 @@ from simulation.trains.sumo_export import (
     export_plain,
     run_netconvert,
 )
-from stations.loader import load
+from liansuo.stations.loader import load
 
 ROOT = Path(__file__).resolve().parent.parent
 SUMO_MISSING = sumo_installed()

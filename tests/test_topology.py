@@ -9,11 +9,11 @@ from __future__ import annotations
 
 import pytest
 
-from stations.loader import load
-from stations.rules import design_rules
-from stations.schema import Direction, SignalKind, TurnoutPosition
-from stations.station import Station
-from stations.topology import Path
+from liansuo.stations.loader import load
+from liansuo.stations.rules import design_rules
+from liansuo.stations.schema import Direction, SignalKind, TurnoutPosition
+from liansuo.stations.station import Station
+from liansuo.stations.topology import Path
 
 N = TurnoutPosition.normal
 R = TurnoutPosition.reverse

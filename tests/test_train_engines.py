@@ -10,9 +10,9 @@ from pathlib import Path
 import pytest
 from conftest import Driver
 
-from simulation.scenario import parse_scenario, run_scenario
-from simulation.sim import Simulation
-from simulation.trains.sumo import sumo_installed
+from liansuo.simulation.scenario import parse_scenario, run_scenario
+from liansuo.simulation.sim import Simulation
+from liansuo.simulation.trains.sumo import sumo_installed
 
 ROOT = Path(__file__).resolve().parent.parent
 SCENARIOS = sorted((ROOT / "examples" / "scenarios").glob("*.yaml"))

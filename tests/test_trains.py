@@ -6,9 +6,9 @@ from __future__ import annotations
 import pytest
 from conftest import Driver
 
-from simulation.sim import Simulation
-from stations.library import bundled
-from stations.loader import load_text
+from liansuo.simulation.sim import Simulation
+from liansuo.stations.library import bundled
+from liansuo.stations.loader import load_text
 
 
 def view(d: Driver, name: str):  # type: ignore[no-untyped-def]

@@ -12,14 +12,14 @@ from typing import Any
 
 import pytest
 
-from tui.app import ConsoleApp
-from tui.diagram import Diagram
-from tui.dialogs import ConfirmScreen, MenuScreen, PasswordScreen
-from tui.layout import Ref
-from tui.paint import BAND_COLOUR, LAMP_COLOUR, glyph
-from tui.panels import FunctionBar
+from liansuo.tui.app import ConsoleApp
+from liansuo.tui.diagram import Diagram
+from liansuo.tui.dialogs import ConfirmScreen, MenuScreen, PasswordScreen
+from liansuo.tui.layout import Ref
+from liansuo.tui.paint import BAND_COLOUR, LAMP_COLOUR, glyph
+from liansuo.tui.panels import FunctionBar
 
-EXERCISES = Path(__file__).resolve().parent.parent / "examples" / "exercises"
+EXERCISES = Path(__file__).resolve().parent.parent / "liansuo" / "exercises"
 SIZE = (120, 36)
 
 
@@ -237,9 +237,9 @@ async def test_instructor_injects_a_broken_rail_from_the_panel_and_the_section_t
 
 @run
 async def test_every_fault_kind_is_offered_and_injects_from_the_panel() -> None:
-    from circuits.faults import KINDS
-    from tui.completion import fault_targets
-    from tui.instructor import InstructorPanel, fault_line
+    from liansuo.circuits.faults import KINDS
+    from liansuo.tui.completion import fault_targets
+    from liansuo.tui.instructor import InstructorPanel, fault_line
 
     app = ConsoleApp("gaotie", paused=True)
     async with app.run_test(size=(140, 44)) as pilot:
@@ -339,8 +339,8 @@ async def test_recording_and_replay_reproduce_the_session(tmp_path: Path) -> Non
     assert [(r["line"], r["by"]) for r in records if r["k"] == "cmd"] == [
         ("route X XI", "trainee"), ("fault broken-rail IG", "instructor"), ("route S SI", "trainee")]
 
-    from simulation.recording import load_recording
-    from tui.replay import ReplayApp
+    from liansuo.simulation.recording import load_recording
+    from liansuo.tui.replay import ReplayApp
 
     rec = load_recording(path)
     replay = ReplayApp(rec, paused=True)
@@ -361,8 +361,8 @@ async def test_recording_and_replay_reproduce_the_session(tmp_path: Path) -> Non
 
 
 def test_variant_buttons_become_the_via_of_the_route() -> None:
-    from simulation import Simulation
-    from tui.operate import Operator
+    from liansuo.simulation import Simulation
+    from liansuo.tui.operate import Operator
 
     sim = Simulation("gaotie")
     op = Operator(sim)

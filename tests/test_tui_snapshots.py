@@ -8,7 +8,7 @@ from typing import Any
 
 import pytest
 
-from tui.app import ConsoleApp
+from liansuo.tui.app import ConsoleApp
 
 
 @pytest.mark.parametrize("size", [(80, 24), (160, 48)], ids=["80x24", "160x48"])

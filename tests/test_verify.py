@@ -8,12 +8,12 @@ from pathlib import Path
 
 import pytest
 
-from interlocking.operations import Interlocking
-from proving.scripts import Script, ScriptTest, Step, run_test
-from proving.verify import verify_station
-from simulation.cli import main
-from stations.library import bundled
-from stations.loader import load
+from liansuo.interlocking.operations import Interlocking
+from liansuo.proving.scripts import Script, ScriptTest, Step, run_test
+from liansuo.proving.verify import verify_station
+from liansuo.simulation.cli import main
+from liansuo.stations.library import bundled
+from liansuo.stations.loader import load
 
 ROOT = Path(__file__).parent.parent
 BROKEN = ROOT / "examples" / "broken" / "gaotie-no-diamond-protection.yaml"
@@ -88,7 +88,7 @@ def test_a_broken_interlocking_fails_with_a_script_that_replays_it(monkeypatch: 
     script = Script("replay.yaml", "jiaopei", [ScriptTest("replay", [Step(s, i + 1) for i, s in enumerate(steps)],
                                                           1)])
     station = load("jiaopei")
-    from interlocking.table import build_table
+    from liansuo.interlocking.table import build_table
 
     outcome = run_test(script, script.tests[0], station, build_table(station))
     assert not outcome.passed and "route X-XI is released, expected locked" in outcome.failure

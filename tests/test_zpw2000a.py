@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from circuits.zpw2000a import (
+from liansuo.circuits.zpw2000a import (
     CARRIERS,
     DEFAULT_PARAMS,
     NO_FAULTS,
@@ -28,10 +28,10 @@ from circuits.zpw2000a import (
     standard_positions,
     sweep,
 )
-from simulation import bench
-from simulation.cli import main
-from stations.library import bundled
-from stations.loader import load, load_text
+from liansuo.simulation import bench
+from liansuo.simulation.cli import main
+from liansuo.stations.library import bundled
+from liansuo.stations.loader import load, load_text
 
 P = DEFAULT_PARAMS
 # Luo Ying 2023 (docs/references.md) tables 1 (open) and 2 (-50 %), over every carrier: the largest fall / rise in

@@ -1,0 +1,62 @@
+"""liansuo (联锁): a trackside signalling and computer-based interlocking simulator for Chinese railway stations.
+
+The public API::
+
+    import liansuo
+
+    station = liansuo.load_station("jiaopei")   # a bundled name or a path to a station file
+    table = liansuo.build_table(station)        # the interlocking table (联锁表)
+    sim = liansuo.Simulation(station)           # the station with its field and interlocking
+    sim.command("route X XI")                   # Result(ok=True, message='route X-XI selected')
+    sim.run(5)                                  # simulated seconds
+    report = liansuo.verify_station(station)    # the automatic interlocking test (联锁试验)
+
+The packages below are the layers (docs/architecture.md): ``stations`` (the station model), ``circuits`` (trackside
+equipment), ``interlocking`` (the CBI), ``simulation`` (the world around it), ``proving`` (what proves it),
+``tui`` (the operator console). The names here are loaded on first use, so importing one layer does not import the
+others.
+"""
+
+from __future__ import annotations
+
+from importlib import import_module
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from liansuo.interlocking.io import Result
+    from liansuo.interlocking.route import InterlockingTable, Route
+    from liansuo.interlocking.table import build_table
+    from liansuo.proving.verify import VerifyReport, verify_station
+    from liansuo.simulation.sim import Simulation
+    from liansuo.stations.loader import load as load_station
+    from liansuo.stations.loader import load_text as load_station_text
+    from liansuo.stations.source import StationError
+    from liansuo.stations.station import Station
+
+__version__ = "0.1.0"
+
+_WHERE = {
+    "Simulation": ("liansuo.simulation.sim", "Simulation"),
+    "Result": ("liansuo.interlocking.io", "Result"),
+    "Station": ("liansuo.stations.station", "Station"),
+    "StationError": ("liansuo.stations.source", "StationError"),
+    "load_station": ("liansuo.stations.loader", "load"),
+    "load_station_text": ("liansuo.stations.loader", "load_text"),
+    "build_table": ("liansuo.interlocking.table", "build_table"),
+    "InterlockingTable": ("liansuo.interlocking.route", "InterlockingTable"),
+    "Route": ("liansuo.interlocking.route", "Route"),
+    "verify_station": ("liansuo.proving.verify", "verify_station"),
+    "VerifyReport": ("liansuo.proving.verify", "VerifyReport"),
+}
+
+__all__ = ["InterlockingTable", "Result", "Route", "Simulation", "Station", "StationError", "VerifyReport",
+           "__version__", "build_table", "load_station", "load_station_text", "verify_station"]
+
+
+def __getattr__(name: str) -> Any:
+    where = _WHERE.get(name)
+    if where is None:
+        raise AttributeError(f"module 'liansuo' has no attribute {name!r}")
+    value = getattr(import_module(where[0]), where[1])
+    globals()[name] = value
+    return value

@@ -1,0 +1,305 @@
+"""The trackside field: every piece of equipment whose relays the interlocking reads.
+
+``Field.step(dt, commands)`` moves time on: switch machines turn, doors open and close, the USU flasher flashes,
+lamps light as commanded, and track circuits follow the wheelsets standing on them (``set_axles``) and the
+teaching panel's switch K (``occupy`` / ``vacate``). Relay states are read through the ``track_up``,
+``indication``, ``lamp_proven``, ``flasher_ok`` and ``doors`` methods; ``take_changes`` says what changed since it
+was last called, so the one reading them copies only that. Faults are injected with ``inject`` and removed with
+``repair`` (``circuits.faults`` parses them).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+
+from liansuo.stations.station import Station
+
+from .doors import PlatformDoors
+from .faults import Fault
+from .flasher import ElectronicFlasher, RelayFlasher
+from .lamps import SignalLamps
+from .machines import SwitchMachine
+from .railgeometry import Axle, RailGeometry
+from .trackcircuits import SectionCircuit, build_circuit
+
+
+@dataclass
+class FieldCommands:
+    """What the interlocking drives, in the field's own terms."""
+
+    drives: dict[str, str] = field(default_factory=dict)  # turnout -> position being driven to
+    lamps: dict[str, set[str]] = field(default_factory=dict)  # signal -> lamps to light
+    flashing: set[str] = field(default_factory=set)  # signals whose flasher is energised (USU)
+    changed_signals: set[str] = field(default_factory=set)  # signals whose lamps or flashing changed
+    doors: dict[str, tuple[bool, bool, bool]] = field(default_factory=dict)  # key -> (ZCKJ, KMJ, GMJ)
+    cab_codes: dict[str, str | None] = field(default_factory=dict)
+
+
+@dataclass
+class Changes:
+    tracks: set[str] = field(default_factory=set)
+    turnouts: set[str] = field(default_factory=set)
+    signals: set[str] = field(default_factory=set)
+    doors: set[str] = field(default_factory=set)
+
+
+class Field:
+    def __init__(self, station: Station, *, flasher: str = "auto") -> None:
+        self.station = station
+        self.geometry = RailGeometry(station)
+        self.circuits: dict[str, SectionCircuit] = {
+            s: build_circuit(station, s, self.geometry.section_length[s]) for s in station.sections}
+        self.machines = {t.id: SwitchMachine(t.id, t.machine.value) for t in station.model.turnouts}
+        self.lamps = {s.id: SignalLamps([lamp.value for lamp in s.lamps]) for s in station.model.signals}
+        self.flashers: dict[str, RelayFlasher | ElectronicFlasher] = {}
+        for s in station.model.signals:
+            if s.usu:
+                kind = s.flasher if flasher == "auto" else flasher
+                self.flashers[s.id] = RelayFlasher() if kind == "relay" else ElectronicFlasher()
+        self.doors = {f"{p.id}:{d.side.value}": PlatformDoors(f"{p.id}:{d.side.value}")
+                      for p in station.model.platforms for d in p.screen_doors}
+        self.faults: dict[tuple[str, str], Fault] = {}
+        self.axles: list[Axle] = []
+        self.shunts: dict[str, list[tuple[float, float]]] = {}
+        self.cab_codes: dict[str, str | None] = {}
+        self._driven: set[str] = set()  # machines with a drive command outstanding
+        self._moving: set[str] = set()
+        self.stamp = 0  # counts the batches of changes taken: what reads the field can tell when nothing changed
+        self._changes = Changes(set(station.sections), set(station.turnouts), set(station.signals),
+                                set(self.doors))
+        for c in self.circuits.values():
+            c.update([])
+
+    # ---- occupancy ------------------------------------------------------------------------------------------
+    def occupy(self, section: str) -> None:
+        self.circuits[section].k_switch = True
+        self._reevaluate(section)
+
+    def vacate(self, section: str) -> None:
+        self.circuits[section].k_switch = False
+        self._reevaluate(section)
+
+    def set_axles(self, axles: Iterable[Axle], more: dict[str, list[tuple[float, float]]] | None = None) -> None:
+        """Where every wheelset stands now (and ``more`` shunts already worked out by section, e.g. a train's);
+        sections whose shunts changed are re-evaluated."""
+        self.axles = list(axles)
+        shunts = self.geometry.shunts_of(self.axles)
+        for sec, lst in (more or {}).items():
+            shunts.setdefault(sec, []).extend(lst)
+        touched = set(shunts) | set(self.shunts)
+        old = self.shunts
+        self.shunts = shunts
+        for sec in touched:
+            if old.get(sec) != shunts.get(sec):
+                self._reevaluate(sec)
+
+    def _reevaluate(self, section: str) -> None:
+        c = self.circuits[section]
+        before = c.up
+        c.update(self.shunts.get(section, []))
+        if c.up != before:
+            self._changes.tracks.add(section)
+
+    # ---- time ----------------------------------------------------------------------------------------------
+    def step(self, dt: float, commands: FieldCommands) -> None:
+        cmd = commands
+        driven = set(cmd.drives) | self._driven
+        for t_id in driven:
+            m = self.machines[t_id]
+            target = cmd.drives.get(t_id)
+            if target != m.target or (target is not None and not m.running):
+                was = (m.dbj, m.fbj)
+                m.drive(target)
+                if m.running:
+                    self._moving.add(t_id)
+                if (m.dbj, m.fbj) != was:
+                    self._changes.turnouts.add(t_id)
+        self._driven = {t for t in driven if t in cmd.drives}
+        for t_id in list(self._moving):
+            m = self.machines[t_id]
+            was = (m.dbj, m.fbj)
+            m.step(dt)
+            if not m.running:
+                self._moving.discard(t_id)
+            if (m.dbj, m.fbj) != was:
+                self._changes.turnouts.add(t_id)
+        for sig in cmd.changed_signals:
+            self._relight(sig, cmd.lamps.get(sig, set()))
+            fl = self.flashers.get(sig)
+            if fl is not None and fl.energised != (sig in cmd.flashing):
+                fl.energise(sig in cmd.flashing)
+                self._changes.signals.add(sig)
+        cmd.changed_signals.clear()
+        for sig, fl in self.flashers.items():
+            if fl.energised:
+                healthy = fl.healthy
+                fl.step(dt)
+                if fl.healthy != healthy:
+                    self._changes.signals.add(sig)
+        for key, d in self.doors.items():
+            before = (d.pdkj, d.pdqcj)
+            if key in cmd.doors:
+                d.command(*cmd.doors[key])
+            d.step(dt)
+            if (d.pdkj, d.pdqcj) != before:
+                self._changes.doors.add(key)
+        self.cab_codes = cmd.cab_codes
+
+    def _relight(self, signal: str, lit: set[str]) -> None:
+        before = self.lamps[signal].proving()
+        self.lamps[signal].apply(lit)
+        if self.lamps[signal].proving() != before:
+            self._changes.signals.add(signal)
+
+    # ---- relays the interlocking reads ------------------------------------------------------------------------
+    def track_up(self, section: str) -> bool:
+        return self.circuits[section].up
+
+    def indication(self, turnout: str) -> tuple[bool, bool]:
+        m = self.machines[turnout]
+        return m.dbj, m.fbj
+
+    def lamp_proven(self, signal: str, lamp: str) -> bool:
+        """DJ for a lit lamp; for an unlit one the cold-filament check (冷丝检测): is a filament intact."""
+        sl = self.lamps[signal]
+        one = sl[lamp]
+        return one.dj_up if lamp in sl.commanded else (one.main_ok or one.backup_ok)
+
+    def filament_alarm(self, signal: str) -> bool:
+        """The filament alarm unit: a main filament broken (the lamp burns on its backup, or is dark)."""
+        return any(not lamp.main_ok for lamp in self.lamps[signal].lamps.values())
+
+    def flasher_ok(self, signal: str) -> bool:
+        """The flash check (SNJJ) while USU is shown; with the flasher idle there is no evidence of a failure."""
+        fl = self.flashers.get(signal)
+        if fl is None:
+            return False
+        return fl.healthy if fl.energised else True
+
+    def doors_relays(self, key: str) -> tuple[bool, bool]:
+        d = self.doors[key]
+        return d.pdkj, d.pdqcj
+
+    def note_turnout(self, turnout: str) -> None:
+        """A turnout's indication may have changed outside a step (a train trailed through it)."""
+        self._changes.turnouts.add(turnout)
+
+    def take_changes(self) -> Changes:
+        out = self._changes
+        self._changes = Changes()
+        if out.tracks or out.turnouts or out.signals or out.doors:
+            self.stamp += 1
+        return out
+
+    # ---- what a person at the lineside would see -----------------------------------------------------------------
+    def machines_running(self) -> set[str]:
+        """Turnouts whose switch machine motors are running now."""
+        return {t for t in self._moving if self.machines[t].running}
+
+    def lit_lamps(self, signal: str) -> set[str]:
+        """Lamps actually lit now, including the flashing lamp's phase."""
+        lit = set(self.lamps[signal].lit())
+        fl = self.flashers.get(signal)
+        if fl is not None and fl.energised:
+            lit.discard("U")
+            if fl.lamp_lit:
+                lit.add("U")
+        return lit
+
+    # ---- faults -------------------------------------------------------------------------------------------------
+    def inject(self, fault: Fault) -> str:
+        """Apply a parsed fault; '' or the reason it cannot be applied."""
+        why = self._apply(fault, on=True)
+        if not why:
+            self.faults[(fault.kind, fault.target)] = fault
+        return why
+
+    def repair(self, kind: str, target: str) -> str:
+        fault = self.faults.get((kind, target))
+        if fault is None:
+            return f"there is no {kind} fault on {target}"
+        why = self._apply(fault, on=False)
+        if not why:
+            del self.faults[(kind, target)]
+        return why
+
+    def _apply(self, f: Fault, *, on: bool) -> str:
+        k, t = f.kind, f.target
+        if k in ("broken-rail", "poor-shunt", "low-ballast", "capacitor"):
+            sf = self.circuits[t].faults
+            if k == "broken-rail":
+                sf.broken_rail_at_m = float(f.get("at")) if on else None
+            elif k == "poor-shunt":
+                sf.poor_shunt_ohm = float(f.get("ohm")) if on else None
+            elif k == "low-ballast":
+                sf.ballast_ohm_km = float(f.get("ohm_km")) if on else None
+            else:
+                n = int(float(f.get("n")))
+                count = len(getattr(self.circuits[t].model, "capacitors_m", ()))
+                if on and not 1 <= n <= count:
+                    return f"section {t} has {count} compensation capacitors; n must be 1..{count}"
+                if on:
+                    sf.capacitors[n] = str(f.get("mode"))
+                else:
+                    sf.capacitors.pop(n, None)
+            self._reevaluate(t)
+        elif k == "insulation":
+            if t in self.station.turnouts:
+                self.machines[t].faults.insulation = on
+                sec = self.station.turnout_section[t]
+                self.circuits[sec].faults.insulation_short = on
+                self._reevaluate(sec)
+            else:
+                lo, hi = self.station.joint_sections(t)
+                for sec in (lo, hi):
+                    self.circuits[sec].faults.joint_failure = on
+                    self._reevaluate(sec)
+        elif k in ("no-indication", "obstruction", "high-resistance", "squeezed"):
+            m = self.machines[t]
+            was = (m.dbj, m.fbj)
+            if k == "no-indication":
+                m.faults.no_indication = on
+            elif k == "obstruction":
+                m.faults.obstruction_mm = float(f.get("mm")) if on else 0.0
+                if not on and m.rails is not None and not m.running:
+                    m.locked = True
+            elif k == "high-resistance":
+                m.faults.resistance_N = float(f.get("N")) if on else None
+            elif on:
+                m.trail("reverse" if m.rails == "normal" else "normal")
+            else:
+                m.repair_squeeze()
+            if (m.dbj, m.fbj) != was:
+                self._changes.turnouts.add(t)
+        elif k == "filament":
+            lamp = str(f.get("lamp"))
+            if on:
+                self.lamps[t].break_filament(lamp, str(f.get("which")))  # type: ignore[arg-type]
+            else:
+                self.lamps[t].repair(lamp)
+            self._relight(t, set(self.lamps[t].commanded))
+            self._changes.signals.add(t)
+        elif k == "flasher":
+            fl = self.flashers[t]
+            if on:
+                fl.bad_contact = True
+            else:
+                fl.repair()
+            self._changes.signals.add(t)
+        else:  # screen doors
+            pid, _, side = t.partition(":")
+            keys = [key for key in self.doors if key.split(":")[0] == pid and (not side or key.endswith(":" + side))]
+            for key in keys:
+                df = self.doors[key].faults
+                if k == "psd-stuck":
+                    df.stuck = on
+                elif k == "psd-no-close":
+                    df.no_close = on
+                elif k == "psd-no-open":
+                    df.no_open = on
+                else:
+                    df.bypass = on
+                self._changes.doors.add(key)
+        return ""
+

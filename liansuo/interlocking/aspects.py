@@ -1,0 +1,118 @@
+"""Aspect selection (Chinese rules): pure functions of the route and the state of the signal ahead.
+
+Codes: L green, LL two greens, LU green-yellow, U yellow, UU two yellows, USU flashing yellow over yellow,
+H red, HB red + moon-white (guide), B moon-white (shunting proceed), A blue (shunting stop).
+Nothing outside this module and ``rules/china.yaml`` knows these rules by name.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from liansuo.stations.schema import SignalKind, TurnoutPosition
+from liansuo.stations.station import Station
+
+from .rules import RuleSet, load_rules
+
+if TYPE_CHECKING:
+    from collections.abc import Iterable
+
+    from .route import Route, RouteTurnout
+
+PROCEED_TRAIN = ("L", "LL", "LU", "U", "UU", "USU")
+STOP = ("H", "A")
+# most permissive first; used to compare aspects
+ORDER = {"L": 6, "LL": 6, "USU": 5, "LU": 5, "UU": 4, "U": 3, "HB": 2, "B": 2, "H": 0, "A": 0, "": 0}
+
+
+def is_open(aspect: str) -> bool:
+    return aspect not in STOP and aspect != ""
+
+
+def stop_aspect(station: Station, signal: str) -> str:
+    return "A" if station.signals[signal].kind is SignalKind.shunting else "H"
+
+
+def usu_allowed(station: Station, route: Route, rules: RuleSet) -> bool:
+    sig = station.signals[route.signal]
+    reverse = [t.id for t in route.turnouts if t.role == "route" and t.position is TurnoutPosition.reverse]
+    return sig.usu and bool(reverse) and all(
+        station.turnouts[t].number >= rules.usu_min_turnout_number for t in reverse)
+
+
+def onward_allows_usu(station: Station, turnouts: Iterable[RouteTurnout], rules: RuleSet) -> bool:
+    """The onward route (of the next signal) runs straight, or diverges over No. 18 or larger turnouts only (技规)."""
+    return all(station.turnouts[t.id].number >= rules.usu_min_turnout_number for t in turnouts
+               if t.role == "route" and t.position is TurnoutPosition.reverse)
+
+
+def possible_aspects(station: Station, route: Route, rules: RuleSet | None = None,
+                     onward: Iterable[Route] = ()) -> tuple[str, ...]:
+    """What the table lists: every proceed aspect the route's signal can show for it (``onward``: the train routes
+    from its end signal)."""
+    rules = rules or load_rules()
+    if route.kind == "shunt":
+        return ("B",)
+    diverging = any(t.role == "route" and t.position is TurnoutPosition.reverse for t in route.turnouts)
+    if route.category == "departure":
+        link = next((lk for lk in station.model.links if lk.id == route.exit_link), None)
+        if link is not None and link.kind.value == "64d":
+            return (rules.semi_auto_departure,)
+        if link is not None and station.link_running(link.id) == "inbound":
+            return ("L",)  # against the running direction, after 改方: the whole line is one block
+        return ("L", "LU", "U")
+    if diverging:
+        usu = usu_allowed(station, route, rules) and any(onward_allows_usu(station, o.turnouts, rules)
+                                                         for o in onward)
+        return ("UU", "USU") if usu else ("UU",)
+    return ("L", "LU", "U")
+
+
+def select_aspect(station: Station, route: Route, next_aspect: str, clear_blocks: int | None,
+                  usu_ready: bool, rules: RuleSet | None = None) -> str:
+    """The aspect to show for an open route.
+
+    ``next_aspect``: the aspect of the signal at the end of the route ('' if none).
+    ``clear_blocks``: clear automatic block sections ahead of a departure (None on 64D lines).
+    ``usu_ready``: the onward route is open, straight or over No. 18+ turnouts, and the flasher is healthy.
+    """
+    rules = rules or load_rules()
+    if route.kind == "shunt":
+        return "B"
+    diverging = any(t.role == "route" and t.position is TurnoutPosition.reverse for t in route.turnouts)
+    if route.category == "departure":
+        if clear_blocks is None:
+            return rules.semi_auto_departure
+        if clear_blocks >= 3:
+            return "L"
+        if clear_blocks == 2:
+            return "LU"
+        if clear_blocks == 1:
+            return "U"
+        return "H"
+    if diverging:
+        if usu_allowed(station, route, rules) and usu_ready and next_aspect in ("L", "LU", "LL", "USU"):
+            return "USU"
+        return "UU"
+    # straight over the main line: follow the next signal
+    if next_aspect == "UU":
+        return "U"
+    if next_aspect in ("L", "LL", "LU", "USU"):
+        return "L"
+    if next_aspect == "U":
+        return "LU"
+    return "U"
+
+
+def downgrade(aspect: str, dark: set[str], rules: RuleSet | None = None) -> str:
+    """The aspect actually commanded when lamps (or 'flasher') in ``dark`` are not proven; never more permissive."""
+    rules = rules or load_rules()
+    seen = set()
+    while aspect not in seen:
+        seen.add(aspect)
+        table = rules.downgrade.get(aspect, {})
+        hit = next((table[d] for d in sorted(dark) if d in table), None)
+        if hit is None:
+            return aspect
+        aspect = hit
+    return aspect

@@ -1,0 +1,338 @@
+"""Seeded defects (mutants) of the interlocking, to show that ``liansuo verify`` and the safety oracle catch them.
+
+Each mutant changes the interlocking's code for as long as it is applied (a context manager patching one method or
+function), the way a plausible programming or design mistake would: a conflict class dropped from the table, a
+protection turnout forgotten, a lock not asked, a release without its three-point check. None touches the oracle,
+verify or the station data. ``liansuo mutate`` runs each against verify (and, if verify misses it, a short random
+run under the oracle) and reports the score (docs/safety.md).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterator
+from contextlib import ExitStack, contextmanager
+from dataclasses import dataclass
+from typing import Any
+from unittest import mock
+
+import liansuo.interlocking.autoblock as autoblock
+import liansuo.interlocking.block64d as block64d
+import liansuo.interlocking.conflicts as conflicts
+import liansuo.interlocking.derive as derive
+import liansuo.interlocking.engine as engine
+import liansuo.interlocking.locks as locks
+import liansuo.interlocking.operations as operations
+from liansuo.interlocking.io import RelayBoard, Result
+from liansuo.interlocking.route import Route
+from liansuo.interlocking.state import RouteStage, RouteState
+
+Apply = Callable[[ExitStack], None]
+
+
+@dataclass(frozen=True)
+class Mutant:
+    name: str
+    what: str  # the defect, in words
+    apply: Apply
+
+    @contextmanager
+    def applied(self) -> Iterator[None]:
+        with ExitStack() as stack:
+            self.apply(stack)
+            yield
+
+
+def _patch(stack: ExitStack, owner: object, attr: str, new: Any) -> None:
+    stack.enter_context(mock.patch.object(owner, attr, new))
+
+
+def _wrap(stack: ExitStack, owner: object, attr: str, make: Callable[[Any], Any]) -> None:
+    _patch(stack, owner, attr, make(getattr(owner, attr)))
+
+
+# ---- the table ------------------------------------------------------------------------------------------------------
+def _no_head_on(s: ExitStack) -> None:
+    _wrap(s, derive, "derive_conflicts",
+          lambda real: lambda routes, rules: real(routes, rules.model_copy(update={"enemy_onto_track": []})))
+
+
+def _no_diamonds(s: ExitStack) -> None:
+    def build(real: Any) -> Any:
+        def without(self: Any) -> Any:
+            saved, self.st.crossings = self.st.crossings, {}
+            try:
+                return real(self)
+            finally:
+                self.st.crossings = saved
+        return without
+    _wrap(s, derive._Builder, "build", build)
+
+
+def _no_protection(s: ExitStack) -> None:
+    _wrap(s, derive._Builder, "_flank", lambda real: lambda self, *a: ({}, real(self, *a)[1]))
+
+
+def _guide_over_lost_indication(s: ExitStack) -> None:
+    def blind(real: Any) -> Any:
+        def open_blocker(self: Any, rs: RouteState, *, guide: bool = False, **kw: Any) -> str:
+            why = real(self, rs, guide=guide, **kw)
+            return "" if guide and why.startswith("turnout") else why
+        return open_blocker
+    _wrap(s, engine.Engine, "open_blocker", blind)
+
+
+def _no_run_on(s: ExitStack) -> None:
+    _patch(s, derive._Builder, "_run_on", lambda self, end, d, tracks, turnouts: (None, ()))
+
+
+def _no_overlap(s: ExitStack) -> None:
+    def add(real: Any) -> Any:
+        def without(self: Any, routes: dict[str, Route], *args: Any) -> None:
+            before = set(routes)
+            real(self, routes, *args)
+            for rid in set(routes) - before:
+                routes[rid].overlap_sections, routes[rid].overlap_turnouts = (), ()
+        return without
+    _wrap(s, derive._Builder, "_add", add)
+
+
+def _approach_one_section(s: ExitStack) -> None:
+    def one(self: Any, signal: str) -> tuple[str, ...]:
+        rear = self.st.signal_rear_track(signal)
+        return (self.st.tracks[rear].section,) if rear else ()
+    _patch(s, derive._Builder, "_approach", one)
+
+
+def _no_conflict_table(s: ExitStack) -> None:
+    _patch(s, conflicts, "_bulk", lambda routes, en, simple: None)
+    _patch(s, conflicts, "_with_run_on", lambda routes, en: None)
+
+
+# ---- the running interlocking ---------------------------------------------------------------------------------------
+def _usu_without_onward(s: ExitStack) -> None:
+    _patch(s, engine, "onward_allows_usu", lambda station, turnouts, rules: True)
+
+
+def _throw_ignores_locks(s: ExitStack) -> None:
+    def throw(real: Any) -> Any:
+        def careless(self: Any, name: str, position: str) -> Result:
+            with mock.patch.object(self.locks, "why_turnout", lambda t: ""):
+                return real(self, name, position)  # type: ignore[no-any-return]
+        return careless
+    _wrap(s, operations.Interlocking, "throw", throw)
+
+
+def _throw_ignores_section_locks(s: ExitStack) -> None:
+    def own(self: Any, turnout: str) -> list[Any]:
+        return [(lk, "") for lk in sorted(self.turnouts.get(turnout, ()), key=locks._order)]
+    _patch(s, locks.LockLedger, "_own_locks", own)
+
+
+def _open_blocker_ignoring(s: ExitStack, ignored: Callable[[str], bool]) -> None:
+    """The signal opens and stays open whenever the only thing against it is a reason ``ignored`` accepts."""
+    def blind(real: Any) -> Any:
+        def open_blocker(self: Any, rs: RouteState, **kw: Any) -> str:
+            why = real(self, rs, **kw)
+            return "" if ignored(why) else why
+        return open_blocker
+    _wrap(s, engine.Engine, "open_blocker", blind)
+
+
+def _blind_to_occupancy(s: ExitStack) -> None:
+    _open_blocker_ignoring(s, lambda why: why.endswith("is occupied"))
+
+
+def _blind_to_indication(s: ExitStack) -> None:
+    _open_blocker_ignoring(s, lambda why: why.startswith("turnout"))
+
+
+def _reopens_by_itself(s: ExitStack) -> None:
+    def advance(real: Any) -> Any:
+        def forgetful(self: Any, rs: RouteState) -> None:
+            if rs.stage is RouteStage.locked and rs.needs_reopen:
+                rs.needs_reopen = rs.opened_once = False
+            real(self, rs)
+        return forgetful
+    _wrap(s, engine.Engine, "_advance", advance)
+
+
+def _no_three_point_check(s: ExitStack) -> None:
+    def release(self: Any, rs: RouteState) -> None:  # a section releases once it is clear again, whatever is next
+        secs = rs.sections
+        for i, sec in enumerate(secs):
+            if not rs.released[i] and not self.clear(sec):
+                rs.was_occupied[i] = True
+        for i, sec in enumerate(secs):
+            if not rs.released[i] and rs.was_occupied[i] and (self.clear(sec) or i == len(secs) - 1):
+                self._release_section(rs, i)
+        if all(rs.released):
+            self.finish(rs, all_sections=False)
+    _patch(s, engine.Engine, "_sequential_release", release)
+
+
+def _cancel_ignores_approach(s: ExitStack) -> None:
+    _patch(s, operations.Interlocking, "approach_locked", lambda self, rs: False)
+
+
+def _no_release_delay(s: ExitStack) -> None:
+    _patch(s, operations.Interlocking, "release_delay", lambda self, r: 0.0)
+
+
+def _no_red_lamp_check(s: ExitStack) -> None:
+    def lamp_alarms(real: Any) -> Any:
+        def deaf(self: Any, signal: str) -> None:
+            real(self, signal)
+            self.signals[signal].red_dark = False
+        return deaf
+    _wrap(s, engine.Engine, "_lamp_alarms", lamp_alarms)
+
+
+def _no_red_lamp_transfer_on_the_line(s: ExitStack) -> None:
+    _wrap(s, autoblock.AutoBlock, "update", lambda real: lambda self, out, clear, proven, red_dark=(),
+          reversed_lines=(): real(self, out, clear, proven, (), reversed_lines))
+
+
+def _no_lamp_proving(s: ExitStack) -> None:
+    _patch(s, engine.Engine, "_proven", lambda self, signal, aspect: aspect)
+
+
+def _deaf_to_flash_check(s: ExitStack) -> None:
+    _patch(s, RelayBoard, "flasher_ok", lambda self, signal: True)
+
+
+def _deaf_to_doors(s: ExitStack) -> None:
+    _patch(s, RelayBoard, "doors_safe", lambda self, key: True)
+
+
+def _no_64d_check(s: ExitStack) -> None:
+    def liaison(real: Any) -> Any:
+        def careless(self: Any, r: Route) -> str:
+            why = real(self, r)
+            return "" if why.startswith("block line") else why
+        return careless
+    _wrap(s, engine.Engine, "_liaison_blocker", liaison)
+
+
+def _block_over_occupied_line(s: ExitStack) -> None:
+    def blind(real: Any) -> Any:
+        def careless(self: Any, action: str, section_clear: bool = True) -> tuple[str, str]:
+            return real(self, action, True)  # type: ignore[no-any-return]
+        return careless
+    _wrap(s, block64d.BlockLink, "operate", blind)
+
+
+def _guide_lock_ignores_doors(s: ExitStack) -> None:
+    _patch(s, engine.Engine, "guide_only_doors", lambda self, signal: [])
+
+
+def _line_without_block_unchecked(s: ExitStack) -> None:
+    _patch(s, derive._Builder, "_line_beyond", lambda self, node, d: ())
+
+
+def _against_running_allowed(s: ExitStack) -> None:
+    _patch(s, engine.Engine, "against_running", lambda self, link: "")
+
+
+def _guide_stays_open(s: ExitStack) -> None:
+    def guide(real: Any) -> Any:
+        def late(self: Any, signal: str) -> Result:
+            result = real(self, signal)
+            rs = self.route_of(signal)
+            if rs is not None:
+                rs.guide_first_clear = False  # closes only once the train is past, not when it enters
+            return result  # type: ignore[no-any-return]
+        return late
+    _wrap(s, operations.Interlocking, "guide", guide)
+
+
+def _no_power_up_lock(s: ExitStack) -> None:
+    def init(real: Any) -> Any:
+        def unlocked(self: Any, *args: Any, locked_at_start: bool = False, **kw: Any) -> None:
+            real(self, *args, locked_at_start=False, **kw)
+        return unlocked
+    _wrap(s, engine.Engine, "__init__", init)
+
+
+def _overlap_released_at_once(s: ExitStack) -> None:
+    def release(real: Any) -> Any:
+        def hasty(self: Any, rs: RouteState) -> None:
+            real(self, rs)
+            if rs.overlap_release_at is not None:
+                rs.overlap_release_at = min(rs.overlap_release_at, self.now)
+        return hasty
+    _wrap(s, engine.Engine, "_sequential_release", release)
+
+
+def _table_conflicts_skipped(s: ExitStack) -> None:
+    _patch(s, operations.Interlocking, "_conditional", lambda self, r, rs: "")
+
+    def blocker(real: Any) -> Any:
+        def careless(self: Any, r: Route, run_on: Any = None) -> str:
+            with mock.patch.object(r, "conflicts", {}):
+                return real(self, r, run_on)  # type: ignore[no-any-return]
+        return careless
+    _wrap(s, operations.Interlocking, "route_blocker", blocker)
+
+
+def _route_ignores_locked_sections(s: ExitStack) -> None:
+    def blocker(real: Any) -> Any:
+        def careless(self: Any, r: Route, run_on: Any = None) -> str:
+            why = real(self, r, run_on)
+            return "" if why.startswith("section") and "is locked" in why else why
+        return careless
+    _wrap(s, operations.Interlocking, "route_blocker", blocker)
+
+
+MUTANTS: tuple[Mutant, ...] = (
+    Mutant("no-head-on-enemies", "the table leaves out opposing routes onto one track (train against train or "
+           "shunting movement)", _no_head_on),
+    Mutant("no-diamond", "the table ignores diamond crossings: no conflict, no protection of the crossing track",
+           _no_diamonds),
+    Mutant("no-flank-protection", "the table lists no flank protection turnouts", _no_protection),
+    Mutant("guide-over-lost-indication", "the guide aspect opens over a route with a turnout out of position or "
+           "without indication", _guide_over_lost_indication),
+    Mutant("no-run-on", "a shunting route ending at a signal of the other direction stops there on paper; the "
+           "movement runs on unprotected", _no_run_on),
+    Mutant("no-overlap", "receiving routes lock no overlap (延续进路)", _no_overlap),
+    Mutant("approach-one-section", "approach locking is one section everywhere, whatever the line",
+           _approach_one_section),
+    Mutant("empty-conflict-table", "the table lists no conflicting routes at all", _no_conflict_table),
+    Mutant("usu-without-onward-check", "USU is given whatever turnouts the onward route diverges over",
+           _usu_without_onward),
+    Mutant("throw-ignores-locks", "individual operation moves a locked turnout", _throw_ignores_locks),
+    Mutant("throw-ignores-section-locks", "a turnout standing in a locked section is not locked with it",
+           _throw_ignores_section_locks),
+    Mutant("blind-to-occupancy", "a signal opens and stays open over an occupied section", _blind_to_occupancy),
+    Mutant("blind-to-indication", "a signal opens and stays open over a turnout without indication",
+           _blind_to_indication),
+    Mutant("reopens-by-itself", "a signal closed abnormally reopens once the fault is gone", _reopens_by_itself),
+    Mutant("no-three-point-check", "sections release as soon as they are clear, without the three-point check",
+           _no_three_point_check),
+    Mutant("cancel-ignores-approach", "a route is cancelled at once with a train approaching",
+           _cancel_ignores_approach),
+    Mutant("no-release-delay", "manual time release releases at once", _no_release_delay),
+    Mutant("no-red-lamp-check", "a dark red lamp goes unnoticed: no red lamp transfer (红灯转移)",
+           _no_red_lamp_check),
+    Mutant("no-red-lamp-transfer-on-the-line", "the block signal in rear of a dark red lamp is not held at H",
+           _no_red_lamp_transfer_on_the_line),
+    Mutant("no-lamp-proving", "a dark lamp does not change the aspect commanded", _no_lamp_proving),
+    Mutant("deaf-to-flash-check", "USU is kept with the flasher's check relay down", _deaf_to_flash_check),
+    Mutant("deaf-to-doors", "signals open with screen doors open", _deaf_to_doors),
+    Mutant("no-64d-acceptance", "a 64D departure opens without the neighbour's acceptance", _no_64d_check),
+    Mutant("64d-block-over-occupied-line", "a 64D block is given with the line's departure section occupied",
+           _block_over_occupied_line),
+    Mutant("line-without-block-unchecked", "a departure onto a line with no block described ignores the line's "
+           "track circuits", _line_without_block_unchecked),
+    Mutant("against-running-direction", "a departure against a line's running direction opens without 改方",
+           _against_running_allowed),
+    Mutant("guide-lock-ignores-doors", "the guide aspect under guide total lock ignores the screen doors",
+           _guide_lock_ignores_doors),
+    Mutant("guide-stays-open", "the guide aspect stays lit after the guided train has entered", _guide_stays_open),
+    Mutant("no-power-up-lock", "after the interlocking starts, the station is not locked", _no_power_up_lock),
+    Mutant("overlap-released-at-once", "the overlap releases as soon as the train is on the receiving track",
+           _overlap_released_at_once),
+    Mutant("table-conflicts-skipped", "route setting skips the table's conflicts (only locked sections and "
+           "turnouts stop it)", _table_conflicts_skipped),
+    Mutant("route-over-locked-sections", "route setting ignores sections other routes hold (an overlap after its "
+           "route has released)", _route_ignores_locked_sections),
+)

@@ -1,0 +1,139 @@
+"""``liansuo mutate``: the score of the checks against seeded defects (:mod:`proving.mutants`).
+
+Each mutant is applied in turn and ``liansuo verify`` run on the stations, stopping at the first failure; a mutant
+verify does not catch gets a short random run (``liansuo soak``) under the safety oracle on each station. A mutant
+is caught when either finds anything. The score is the share caught.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import multiprocessing
+import os
+import time
+from collections.abc import Callable, Iterable, Sequence
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass
+from pathlib import Path
+
+from liansuo.simulation.hubgen import generate_hub
+from liansuo.stations.library import bundled
+from liansuo.stations.loader import load, load_text
+from liansuo.stations.station import Station
+
+from .mutants import MUTANTS, Mutant
+from .soak import soak
+from .verify import verify_station
+
+Add = Callable[..., argparse.ArgumentParser]
+SOAK_STEPS = 300
+
+
+@dataclass
+class Caught:
+    mutant: str
+    what: str
+    by: str  # 'verify', 'oracle' (a safety property, during verify or a soak), or '' (not caught)
+    station: str = ""
+    check: str = ""
+    detail: str = ""
+    seconds: float = 0.0
+
+    def as_dict(self) -> dict[str, object]:
+        return {"mutant": self.mutant, "what": self.what, "caught_by": self.by or None, "station": self.station,
+                "check": self.check, "detail": self.detail, "seconds": round(self.seconds, 2)}
+
+
+HUB = "hub:10:4"  # a small generated hub: lines with no block described, double crossovers, paired signals
+
+
+def default_stations() -> list[str]:
+    """The bundled stations, the example stations when run from a checkout, and a small generated hub; the quickest
+    to verify first."""
+    out = sorted(bundled(), key=lambda name: (name != "jiaopei", name))
+    examples = Path(__file__).resolve().parents[2] / "examples" / "stations"
+    if examples.is_dir():
+        out[1:1] = [str(p) for p in sorted(examples.glob("*.yaml")) if p.stem != "minimal"]
+    return [*out, HUB]
+
+
+def load_station(spec: str) -> Station:
+    """A bundled name, a station file, or ``hub:TURNOUTS:TRACKS`` for a generated hub."""
+    if spec.startswith("hub:"):
+        turnouts, tracks = (int(x) for x in spec.split(":")[1:3])
+        return load_text(generate_hub(turnouts, tracks), f"<hub{turnouts}>")
+    return load(spec)
+
+
+def try_mutant(m: Mutant, stations: Sequence[Station], soak_steps: int = SOAK_STEPS) -> Caught:
+    t0 = time.perf_counter()
+    with m.applied():
+        for st in stations:
+            rep = verify_station(st, stop_at_first=True)
+            if rep.failures:
+                f = rep.failures[0]
+                by = "oracle" if f.check == "oracle" else "verify"
+                return Caught(m.name, m.what, by, st.id, f.check if by == "verify" else f.subject, f.detail,
+                              time.perf_counter() - t0)
+        for st in stations:
+            run = soak(st, soak_steps, 1)
+            if run.violations:
+                v = run.violations[0][0]
+                return Caught(m.name, m.what, "oracle", st.id, v.prop, f"soak: {v.text}", time.perf_counter() - t0)
+    return Caught(m.name, m.what, "", seconds=time.perf_counter() - t0)
+
+
+def _one(args: tuple[str, list[str], int]) -> Caught:
+    name, stations, soak_steps = args
+    m = next(x for x in MUTANTS if x.name == name)
+    return try_mutant(m, [load_station(s) for s in stations], soak_steps)
+
+
+def run_mutants(stations: Iterable[str] | None = None, mutants: Iterable[Mutant] = MUTANTS,
+                soak_steps: int = SOAK_STEPS, workers: int | None = None) -> list[Caught]:
+    """Try every mutant; ``workers`` processes at once (default: one per CPU), each mutant in a process of its
+    own so its patches never leak into another's run."""
+    names = [m.name for m in mutants]
+    chosen = list(stations or default_stations())
+    jobs = [(n, chosen, soak_steps) for n in names]
+    with ProcessPoolExecutor(max_workers=workers or os.cpu_count() or 1,
+                             mp_context=multiprocessing.get_context("fork")) as pool:
+        return list(pool.map(_one, jobs))
+
+
+def report_text(results: list[Caught]) -> str:
+    caught = sum(bool(r.by) for r in results)
+    lines = [f"liansuo mutate: {len(results)} seeded defects"]
+    for r in results:
+        where = f"{r.by} on {r.station} ({r.check})" if r.by else "NOT CAUGHT"
+        lines.append(f"  {r.mutant:34} {where}")
+        if r.by:
+            lines.append(f"      {r.detail[:150]}")
+    lines.append(f"score: {caught} of {len(results)} caught ({100 * caught / max(1, len(results)):.0f} %)")
+    return "\n".join(lines)
+
+
+def cmd_mutate(args: argparse.Namespace) -> int:
+    chosen = [m for m in MUTANTS if not args.mutant or m.name in args.mutant]
+    t0 = time.perf_counter()
+    results = run_mutants(args.station or None, chosen, args.soak_steps)
+    caught = sum(bool(r.by) for r in results)
+    if args.format == "json":
+        print(json.dumps({"mutants": len(results), "caught": caught, "score": round(caught / max(1, len(results)), 3),
+                          "elapsed_s": round(time.perf_counter() - t0, 1),
+                          "results": [r.as_dict() for r in results]}, ensure_ascii=False, indent=2))
+    else:
+        print(report_text(results))
+    return 0 if caught == len(results) else 1
+
+
+def register(add: Add) -> None:
+    sp = add("mutate", cmd_mutate, "seed defects into the interlocking and show that verify and the oracle catch them")
+    sp.add_argument("--station", action="append", metavar="STATION",
+                    help="station to run on (repeatable; default: the bundled and example stations)")
+    sp.add_argument("--mutant", action="append", metavar="NAME", help="only this mutant (repeatable)")
+    sp.add_argument("--soak-steps", type=int, default=SOAK_STEPS,
+                    help=f"random steps per station for a mutant verify misses (default {SOAK_STEPS})")
+    sp.add_argument("--format", choices=("text", "json"), default="text")
+    sp.set_defaults(handler=cmd_mutate)

@@ -1,0 +1,187 @@
+"""The oracle watching a running :class:`~simulation.sim.Simulation`: after every cycle and every command.
+
+``Watch(sim)`` wraps ``sim.step`` and ``sim.command``; every finding is kept once, when it starts, as a
+:class:`Violation` (or, for what the interlocking cannot see, a hazard). The simulation is read through
+:class:`SimulationView`: the field's lamps, switch machines, relays, wheelsets and doors, the virtual neighbours'
+block machines, and the console's answer to "is this turnout locked".
+"""
+
+from __future__ import annotations
+
+import shlex
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+from liansuo.interlocking.rules import RuleSet
+
+from .check import Finding, Oracle
+
+if TYPE_CHECKING:
+    from liansuo.interlocking.io import Result
+    from liansuo.simulation.sim import Simulation
+
+
+@dataclass(frozen=True)
+class Violation:
+    t: float
+    prop: str
+    text: str
+    cycle: int  # the interlocking's cycle count
+    key: str = ""  # what it is about (the same key is the same finding)
+    hazard: bool = False  # a danger the interlocking cannot see by design, not a violation of its own
+
+    def as_dict(self) -> dict[str, object]:
+        return {"t": self.t, "property": self.prop, "text": self.text, "cycle": self.cycle, "key": self.key,
+                "hazard": self.hazard}
+
+
+class SimulationView:
+    """The field as it is, read from a simulation (see :class:`~proving.oracle.view.FieldView`)."""
+
+    def __init__(self, sim: Simulation) -> None:
+        self.sim = sim
+        self.field = sim.field
+        st = sim.station
+        self.stop = {s.id: ("A" if s.kind.value == "shunting" else "H") for s in st.model.signals}
+        self.platform_keys: dict[str, list[str]] = {}
+        for p in st.model.platforms:
+            for d in p.screen_doors:
+                self.platform_keys.setdefault(p.section, []).append(f"{p.id}:{d.side.value}")
+        self._wheelsets: tuple[float, list[tuple[str, float]]] | None = None
+
+    def showing(self) -> list[str]:
+        """Signals with a lamp lit other than their stop lamp."""
+        out = []
+        for sig, lamps in self.field.lamps.items():
+            commanded = lamps.commanded
+            if commanded and (len(commanded) > 1 or self.stop[sig] not in commanded):
+                out.append(sig)
+        return out
+
+    def lit(self, signal: str) -> frozenset[str]:
+        lit = set(self.field.lamps[signal].lit())
+        fl = self.field.flashers.get(signal)
+        if fl is not None and fl.energised and fl.bad_contact:
+            lit.discard("U")  # the flashing lamp stays dark
+        return frozenset(lit)
+
+    def flashing(self, signal: str) -> bool:
+        fl = self.field.flashers.get(signal)
+        return fl is not None and fl.energised and not fl.bad_contact and "U" in self.field.lamps[signal].lit()
+
+    def proven_lit(self, signal: str) -> tuple[frozenset[str], bool]:
+        lamps = self.field.lamps[signal]
+        lit = frozenset(name for name in lamps.commanded if lamps.lamps[name].dj_up)
+        fl = self.field.flashers.get(signal)
+        return lit, fl is not None and fl.energised and self.field.flasher_ok(signal)
+
+    def rails(self, turnout: str) -> str | None:
+        return self.field.machines[turnout].rails
+
+    def running(self, turnout: str) -> bool:
+        return self.field.machines[turnout].running
+
+    def target(self, turnout: str) -> str | None:
+        return self.field.machines[turnout].target
+
+    def moving(self) -> set[str]:
+        """Machines running towards a position other than where the rails lie (a machine retrying the position
+        its rails are already in moves nothing)."""
+        ms = self.field.machines
+        return {t for t in self.field.machines_running() if ms[t].rails != ms[t].target}
+
+    def proven(self, turnout: str) -> str | None:
+        dbj, fbj = self.field.indication(turnout)
+        if dbj and not fbj:
+            return "normal"
+        if fbj and not dbj:
+            return "reverse"
+        return None
+
+    def clear(self, section: str) -> bool:
+        return self.field.track_up(section)
+
+    def locked(self, turnout: str) -> bool:
+        return self.sim.turnout_state(turnout)[1]
+
+    def wheelsets(self, tracks: set[str]) -> list[tuple[str, float]]:
+        if self._wheelsets is None or self._wheelsets[0] != self.sim.t:
+            every = [(a.track, a.x) for a in self.field.axles]
+            fleet = self.sim.fleet
+            for tr in fleet.trains.values():
+                every += [(a.track, a.x) for a in fleet.track.axles(tr.pos, tr.consist.axle_offsets_m)]
+            self._wheelsets = (self.sim.t, every)
+        return [(t, x) for t, x in self._wheelsets[1] if t in tracks]
+
+    def doors_safe(self, section: str) -> bool:
+        doors = self.field.doors
+        return all(not doors[k].is_open or doors[k].faults.bypass for k in self.platform_keys.get(section, ()))
+
+    def line_permits(self, link: str) -> bool:
+        return self.sim.neighbours.permits(link)
+
+    def line_outbound(self, link: str) -> bool:
+        return self.sim.line_outbound(link)
+
+
+class Watch:
+    """An oracle attached to a simulation; ``violations`` and ``hazards`` are what it found, in order."""
+
+    def __init__(self, sim: Simulation, *, attach: bool = True, rules: RuleSet | None = None,
+                 reaction: int = 2) -> None:
+        self.sim = sim
+        self.oracle = Oracle(sim.station, rules or sim.rules, cycle_s=sim.cycle_s, reaction=reaction)
+        self.view = SimulationView(sim)
+        self.violations: list[Violation] = []
+        self.hazards: list[Violation] = []
+        self.cycles = 0
+        self._last: tuple[object, ...] = ()
+        if attach:
+            self.attach()
+        self.check()
+
+    def attach(self) -> None:
+        sim = self.sim
+        step, command = sim.step, sim.command
+
+        def checked_step() -> None:
+            step()
+            self.check()
+
+        def noted_command(line: str) -> Result:
+            result = command(line)
+            self.note(line, result)
+            return result
+
+        sim.step = checked_step  # type: ignore[method-assign]
+        sim.command = noted_command  # type: ignore[method-assign]
+
+    def note(self, line: str, result: Result) -> None:
+        try:
+            words = shlex.split(line.split("#", 1)[0])
+        except ValueError:
+            return
+        self.oracle.note(words, result.ok)
+
+    def _signature(self) -> tuple[object, ...]:
+        """What the world looks like, in a few numbers: when it is the same as at the last check and nothing there
+        runs on time, the findings are the same too."""
+        sim = self.sim
+        f = sim.field
+        return (f.stamp, sim.interlocking.locks.version, id(f.axles), sim.t if sim.fleet.trains else 0.0,
+                tuple((t, f.machines[t].target) for t in f.machines_running()),
+                tuple(nb.accepted for nb in sim.neighbours.by_link.values()),
+                tuple(sim.interlocking.out.line_direction.items()))
+
+    def check(self) -> list[Finding]:
+        self.cycles += 1
+        signature = self._signature()
+        if signature == self._last and not self.oracle.busy():
+            return []
+        self._last = signature
+        new = self.oracle.check(self.view, self.sim.t, self.view.showing())
+        cycle = self.sim.interlocking.cycles
+        for f in new:
+            v = Violation(self.sim.t, f.prop, f.text, cycle, f.key, f.hazard)
+            (self.hazards if f.hazard else self.violations).append(v)
+        return new

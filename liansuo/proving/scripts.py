@@ -1,0 +1,174 @@
+"""YAML route-test scripts (``liansuo test``).
+
+```yaml
+station: jiaopei
+tests:
+  - name: receiving route onto the main track
+    steps:
+      - route X XI
+      - run 15s
+      - expect signal X U
+```
+Each test runs on a fresh simulation. A command that is refused fails the test unless the next step is
+``expect refused ...``. A failing step prints the step, what was expected and what the state was. With
+``safety: true`` the safety oracle (:class:`~proving.oracle.Watch`) watches every cycle and a violation of a safety
+property fails the test at the step where it happens (``liansuo soak`` writes its reproducers this way); a hazard (a
+danger the interlocking cannot see by design, such as a vehicle hidden in a dead zone) is reported without failing the
+test, and ``expect hazard TEXT`` checks that one was seen.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from liansuo.interlocking.io import Result
+from liansuo.simulation.commands import read_steps
+from liansuo.simulation.sim import Simulation
+from liansuo.stations.loader import load
+from liansuo.stations.source import Diagnostic, StationError, read_file
+from liansuo.stations.station import Station
+
+from .oracle import Watch
+
+
+@dataclass
+class Step:
+    text: str
+    line: int
+
+
+@dataclass
+class ScriptTest:
+    name: str
+    steps: list[Step]
+    line: int
+
+
+@dataclass
+class Script:
+    file: str
+    station: str
+    tests: list[ScriptTest]
+    cycle_s: float = 0.25
+    safety: bool = False  # check the safety properties every cycle
+
+
+@dataclass
+class Outcome:
+    script: str
+    name: str
+    passed: bool
+    failure: str = ""
+    line: int = 0
+    log: list[str] = field(default_factory=list)
+    hazards: list[str] = field(default_factory=list)  # what the oracle found that the interlocking cannot see
+
+
+def parse_script(path: Path) -> Script:
+    src = read_file(path, "give the path of a YAML test script (see examples/scripts/)")
+    errors: list[Diagnostic] = []
+    data = src.data
+    if not isinstance(data, dict):
+        raise StationError([src.diagnostic((), "a test script is a mapping with 'station:' and 'tests:'",
+                                           "see examples/ for scripts")])
+    for key in data:
+        if key not in ("station", "tests", "cycle_ms", "safety"):
+            errors.append(src.diagnostic((key,), f"unknown key '{key}'", "a script has station, tests and "
+                                         "optionally cycle_ms and safety", at_key=True))
+    station = data.get("station")
+    if not isinstance(station, str):
+        errors.append(src.diagnostic(("station",) if "station" in data else (), "missing or invalid 'station:'",
+                                     "name a bundled station or a station file path"))
+    tests_raw = data.get("tests")
+    tests: list[ScriptTest] = []
+    if not isinstance(tests_raw, list) or not tests_raw:
+        errors.append(src.diagnostic(("tests",) if "tests" in data else (), "'tests:' must be a non-empty list", ""))
+        tests_raw = []
+    for i, t in enumerate(tests_raw):
+        if not isinstance(t, dict) or not isinstance(t.get("name"), str) or not isinstance(t.get("steps"), list):
+            errors.append(src.diagnostic(("tests", i), "each test needs 'name:' and a list of 'steps:'", ""))
+            continue
+        for key in t:
+            if key not in ("name", "steps"):
+                errors.append(src.diagnostic(("tests", i, key), f"unknown key '{key}' in a test", "", at_key=True))
+        steps = [Step(s, line) for s, line in read_steps(src, ("tests", i, "steps"), t["steps"], errors)]
+        tests.append(ScriptTest(t["name"], steps, src.mark(("tests", i)).line))
+    cycle_ms = data.get("cycle_ms", 250)
+    if not isinstance(cycle_ms, int | float) or isinstance(cycle_ms, bool) or not 10 <= cycle_ms <= 2000:
+        errors.append(src.diagnostic(("cycle_ms",), "cycle_ms must be a number from 10 to 2000", ""))
+        cycle_ms = 250
+    safety = data.get("safety", False)
+    if not isinstance(safety, bool):
+        errors.append(src.diagnostic(("safety",), "safety must be true or false", ""))
+        safety = False
+    if errors:
+        raise StationError(errors)
+    return Script(str(path), str(station), tests, cycle_ms / 1000.0, safety)
+
+
+def _resolve_station(script: Script, src_dir: Path) -> Station:
+    try:
+        return load(script.station)
+    except StationError:
+        candidate = src_dir / script.station
+        if candidate.exists():
+            return load(candidate)
+        raise
+
+
+def run_script(script: Script, only: str | None = None) -> list[Outcome]:
+    station = _resolve_station(script, Path(script.file).parent)
+    from liansuo.interlocking.table import build_table
+
+    table = build_table(station)
+    outcomes = []
+    for test in script.tests:
+        if only and only.lower() not in test.name.lower():
+            continue
+        outcomes.append(run_test(script, test, station, table))
+    return outcomes
+
+
+def run_test(script: Script, test: ScriptTest, station: Station, table: object) -> Outcome:
+    sim = Simulation(station, cycle_s=script.cycle_s, table=table)  # type: ignore[arg-type]
+    checker = Watch(sim) if script.safety else None
+    log: list[str] = []
+    steps = test.steps
+    for k, step in enumerate(steps):
+        result = _expect_hazard(step.text, checker) or sim.command(step.text)
+        log.append(f"{step.text} -> {'ok' if result.ok else 'refused'}: {result.message}")
+        if checker is not None and checker.violations:
+            v = checker.violations[0]
+            return Outcome(script.file, test.name, False, f"step '{step.text}': safety violation at t = {v.t:g} s "
+                           f"({v.prop}): {v.text}", step.line, log, _hazards(checker))
+        is_expect = step.text.strip().startswith("expect")
+        if result.ok:
+            continue
+        if not is_expect:
+            nxt = steps[k + 1].text.strip() if k + 1 < len(steps) else ""
+            if nxt.startswith("expect refused"):
+                continue
+            return Outcome(script.file, test.name, False,
+                           f"step '{step.text}' was refused: {result.message}", step.line, log, _hazards(checker))
+        return Outcome(script.file, test.name, False, f"step '{step.text}': {result.message} (t = {sim.t:g} s)",
+                       step.line, log, _hazards(checker))
+    return Outcome(script.file, test.name, True, log=log, hazards=_hazards(checker))
+
+
+def _expect_hazard(line: str, checker: Watch | None) -> Result | None:
+    """``expect hazard TEXT``: the oracle has reported a hazard (a danger the interlocking cannot see by design)
+    whose text contains TEXT; needs ``safety: true``. None for any other line."""
+    words = line.split("#", 1)[0].split()
+    if words[:2] != ["expect", "hazard"]:
+        return None
+    if checker is None:
+        return Result.refuse("'expect hazard' needs the safety oracle: add 'safety: true' to the script")
+    text = " ".join(words[2:]).lower()
+    seen = [h.text for h in checker.hazards]
+    hits = [h for h in seen if text in h.lower()]
+    return Result(bool(hits), f"hazards: {'; '.join(seen) or 'none'}")
+
+
+def _hazards(checker: Watch | None) -> list[str]:
+    return [f"t = {h.t:g} s {h.prop}: {h.text}" for h in checker.hazards] if checker is not None else []

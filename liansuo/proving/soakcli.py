@@ -1,0 +1,156 @@
+"""``liansuo soak STATION --steps N --seed S [--format text|json] [--out DIR]``: long random runs under the safety
+oracle, with a reproducer script for each violation.
+
+A reproducer is a YAML test script with ``safety: true``: ``liansuo test FILE`` (or pytest) replays the commands and
+fails at the step where the violation happens. It is cut down from the run: first the shortest tail of the commands
+before the violation that still shows it on a fresh station, then single steps and chunks are dropped while it still
+does (within a budget of replays).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+from liansuo.simulation.sim import Simulation
+
+from .oracle import Violation, Watch
+from .soak import SoakRun, soak
+
+Add = Callable[..., argparse.ArgumentParser]
+MAX_REPRODUCERS = 5
+SHRINK_BUDGET_S = 30.0
+
+
+def shows(station: str, lines: list[str], key: str, cycle_s: float = 0.25) -> bool:
+    """Do ``lines`` on a fresh simulation lead to a violation with ``key``?"""
+    sim = Simulation(station, cycle_s=cycle_s)
+    checker = Watch(sim)
+    for line in lines:
+        sim.command(line)
+        if any(v.key == key for v in checker.violations):
+            return True
+    return False
+
+
+def shrink(station: str, lines: list[str], key: str, budget_s: float = SHRINK_BUDGET_S) -> list[str]:
+    """A short list of lines that still shows the violation ``key`` (``lines`` itself if nothing shorter does)."""
+    deadline = time.perf_counter() + budget_s
+    best = lines
+    n = 16
+    while n < len(lines):  # the shortest tail that shows it
+        if time.perf_counter() > deadline:
+            return best
+        if shows(station, lines[-n:], key):
+            best = lines[-n:]
+            break
+        n *= 2
+    chunk = max(1, len(best) // 2)
+    while chunk >= 1 and time.perf_counter() < deadline:
+        i = 0
+        while i < len(best) and time.perf_counter() < deadline:
+            candidate = best[:i] + best[i + chunk:]
+            if candidate and shows(station, candidate, key):
+                best = candidate
+            else:
+                i += chunk
+        chunk //= 2
+    return best
+
+
+def merge_runs(lines: list[str]) -> list[str]:
+    """Consecutive ``run Nms`` lines as one (the same cycles)."""
+    out: list[str] = []
+    for line in lines:
+        if line.startswith("run ") and line.endswith("ms") and out and out[-1].startswith("run ") \
+                and out[-1].endswith("ms"):
+            out[-1] = f"run {int(out[-1][4:-2]) + int(line[4:-2])}ms"
+        else:
+            out.append(line)
+    return out
+
+
+def annotate_refusals(station: str, lines: list[str], cycle_s: float = 0.25) -> list[str]:
+    """The lines with ``expect refused ...`` after each command a fresh station refuses, so that the script replays
+    under ``liansuo test`` (where a refused command otherwise fails the test) up to the violation."""
+    sim = Simulation(station, cycle_s=cycle_s)
+    out: list[str] = []
+    for line in lines:
+        out.append(line)
+        result = sim.command(line)
+        if not result.ok and not line.startswith("run "):
+            out.append(f"expect refused {result.message[:60]}")
+    return out
+
+
+def reproducer(run: SoakRun, v: Violation, lines: list[str]) -> str:
+    import yaml
+
+    lines = annotate_refusals(run.source, merge_runs(lines))
+
+    head = (f"# liansuo soak {run.station} --seed {run.seed}: at t = {v.t:g} s, {v.prop}: {v.text}\n"
+            f"# Replays with the safety oracle on: 'liansuo test FILE' fails at the step where it happens.\n")
+    body = {"station": run.source, "safety": True,
+            "tests": [{"name": f"soak seed {run.seed}: {v.prop} {v.key.partition(':')[2]}", "steps": lines}]}
+    return head + yaml.safe_dump(body, allow_unicode=True, sort_keys=False, width=200)
+
+
+def report(run: SoakRun, *, shrink_budget_s: float = SHRINK_BUDGET_S) -> dict[str, object]:
+    done: set[str] = set()
+    out = []
+    for v, n in run.violations:
+        entry: dict[str, object] = {**v.as_dict(), "line": n, "reproducer": None}
+        if v.key not in done and len(done) < MAX_REPRODUCERS:
+            done.add(v.key)
+            entry["reproducer"] = reproducer(run, v, shrink(run.source, run.lines[:n], v.key, shrink_budget_s))
+        out.append(entry)
+    return {"station": run.station, "seed": run.seed, "steps": run.steps, "cycles": run.cycles,
+            "simulated_s": round(run.simulated_s, 2), "commands": len(run.lines), "refused": run.refused,
+            "elapsed_s": round(run.elapsed_s, 2), "hazards": dict(sorted(run.hazards.items())), "violations": out}
+
+
+def cmd_soak(args: argparse.Namespace) -> int:
+    from liansuo.stations.source import StationError
+
+    try:
+        run = soak(args.station, args.steps, args.seed)
+    except StationError as exc:
+        for d in exc.diagnostics:
+            print(d, file=sys.stderr)
+        return 1
+    rep = report(run)
+    violations: list[dict[str, object]] = rep["violations"]  # type: ignore[assignment]
+    if args.out:
+        out = Path(args.out)
+        out.mkdir(parents=True, exist_ok=True)
+        for k, v in enumerate(x for x in violations if x["reproducer"]):
+            (out / f"soak-{run.station}-{run.seed}-{k + 1}.yaml").write_text(str(v["reproducer"]), encoding="utf-8")
+    if args.format == "json":
+        print(json.dumps(rep, ensure_ascii=False, indent=2))
+    else:
+        print(f"liansuo soak {run.station}: {run.steps} steps (seed {run.seed}), {run.cycles} cycles, "
+              f"{run.simulated_s:.0f} s simulated, {len(run.lines)} commands ({run.refused} refused), "
+              f"{run.elapsed_s:.1f} s")
+        if run.hazards:
+            print("hazards (dangers the interlocking cannot see by design, not violations): "
+                  + ", ".join(f"{k} {n}" for k, n in sorted(run.hazards.items())))
+        for v in violations:
+            print(f"VIOLATION t = {v['t']:g} s {v['property']}: {v['text']}")
+            if v["reproducer"]:
+                print("  reproducer:\n" + "\n".join(f"    {line}" for line in str(v["reproducer"]).splitlines()))
+        print(f"{len(violations)} violations")
+    return 1 if violations else 0
+
+
+def register(add: Add) -> None:
+    sp = add("soak", cmd_soak, "random operation under the safety oracle; a reproducer script per violation")
+    sp.add_argument("station", help="bundled station name or path to a station YAML file")
+    sp.add_argument("--steps", type=int, default=10_000, help="random steps (default 10000)")
+    sp.add_argument("--seed", type=int, default=1)
+    sp.add_argument("--format", choices=("text", "json"), default="text")
+    sp.add_argument("--out", metavar="DIR", help="also write each reproducer to DIR/soak-STATION-SEED-N.yaml")
+    sp.set_defaults(handler=cmd_soak)

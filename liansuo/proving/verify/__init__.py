@@ -1,0 +1,136 @@
+"""``liansuo verify``: the automatic interlocking test (联锁试验) of a whole station.
+
+Every route of the table goes through the items of a real test record (:mod:`.routes`, :mod:`.release`), every
+pair of routes is tried together (:mod:`.pairs`), the station data is checked against the topology and the design
+rules (:mod:`.data`), and the throats' guide total lock is tried. Each dynamic check runs on a fresh simulation
+driven only through the command language, so every failure comes with the script that shows it.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from liansuo.interlocking.rules import RuleSet, load_rules
+from liansuo.interlocking.table import InterlockingTable, build_table
+from liansuo.stations.loader import load
+from liansuo.stations.station import Station
+
+from ..oracle.pairs import PaperOracle
+from .against import approach_extent, pair_conflicts, route_demands
+from .data import check_station
+from .pairs import PairTest
+from .probe import Context, Failure, FirstFailure
+from .release import throat_checks
+from .routes import RouteResult, RouteTest
+from .station import power_up, red_lamp_transfer
+
+
+@dataclass
+class VerifyReport:
+    station: str
+    name: str
+    routes: int
+    routes_tested: int
+    pairs_tested: int
+    pairs_conflicting: int
+    pairs_compatible: int
+    checks: int
+    failures: list[Failure]
+    warnings: list[Failure]
+    results: list[RouteResult] = field(default_factory=list)
+    table: InterlockingTable | None = None
+    elapsed_s: float = 0.0
+    strict: bool = False
+
+    @property
+    def ok(self) -> bool:
+        return not self.failures and not (self.strict and self.warnings)
+
+    def as_dict(self) -> dict[str, object]:
+        aspects = {r.id: r.aspects for r in self.table.routes.values()} if self.table else {}
+        return {
+            "station": self.station,
+            "routes": self.routes,
+            "routes_tested": self.routes_tested,
+            "pairs_tested": self.pairs_tested,
+            "pairs_conflicting": self.pairs_conflicting,
+            "pairs_compatible": self.pairs_compatible,
+            "checks": self.checks,
+            "failures": [f.as_dict() for f in self.failures],
+            "warnings": [f.as_dict() for f in self.warnings],
+            "strict": self.strict,
+            "ok": self.ok,
+            "route_results": [r.as_dict(aspects.get(r.id, ())) for r in self.results],
+            "elapsed_s": round(self.elapsed_s, 2),
+        }
+
+
+def verify_station(station: str | Path | Station, *, routes: list[str] | None = None, pairs: bool = True,
+                   strict: bool = False, rules: RuleSet | None = None, cycle_s: float = 0.25,
+                   stop_at_first: bool = False) -> VerifyReport:
+    """Run the whole interlocking test; ``routes`` limits route and pair checks to those routes. The table is held
+    against the oracle first (quick), then every route and pair is tried on the running simulation.
+    ``stop_at_first``: stop at the first failure (the mutation run only needs to know that one was found)."""
+    t0 = time.perf_counter()
+    st = station if isinstance(station, Station) else load(station)
+    rules = rules or load_rules()
+    table = build_table(st, rules)
+    ctx = Context(st, table, rules, cycle_s, stop_at_first=stop_at_first)
+    focus = set(routes) if routes else None
+    results: list[RouteResult] = []
+    pair_test = PairTest(ctx)
+    try:
+        if focus:
+            for rid in sorted(focus - set(table.routes)):
+                ctx.record(False, "route", rid, f"there is no route {rid}; see 'liansuo table {st.id}'")
+        oracle = PaperOracle(st, ctx.rules)
+        for r in table.routes.values():
+            if not focus or r.id in focus:
+                route_demands(ctx, oracle, r)
+        if pairs:
+            pair_conflicts(ctx, oracle, focus)
+        if not focus:
+            approach_extent(ctx)
+        for r in table.routes.values():
+            if not focus or r.id in focus:
+                results.append(RouteTest(ctx, r).run())
+        if pairs:
+            pair_test.run(table.routes.values(), focus)
+        if not focus:
+            throat_checks(ctx)
+            power_up(ctx)
+            red_lamp_transfer(ctx)
+        check_station(ctx, focus)
+    except FirstFailure:
+        pass
+    return VerifyReport(st.id, st.display_name(), len(table.routes), len(results), pair_test.tested,
+                        pair_test.conflicting, pair_test.compatible, ctx.checks, ctx.failures, ctx.warnings,
+                        results, table, time.perf_counter() - t0, strict)
+
+
+def report_text(rep: VerifyReport, *, verbose: bool = False) -> str:
+    lines = [f"liansuo verify {rep.station}: {rep.name}"]
+    lines.append(f"routes    {rep.routes_tested} of {rep.routes} tested")
+    aspects = {r.id: r.aspects for r in rep.table.routes.values()} if rep.table else {}
+    for res in rep.results:
+        table = aspects.get(res.id, ())
+        shown = [a for a in table if a in res.aspects_seen]
+        status = "ok  " if not res.failures else f"FAIL {res.failures}"
+        lines.append(f"  {res.id:16} {status:7} {res.checks:4} checks   aspects {'/'.join(shown) or '-':10} of "
+                     f"{'/'.join(table)}")
+    lines.append(f"pairs     {rep.pairs_tested} tested: {rep.pairs_conflicting} conflicting (each refused after the "
+                 f"other, both ways), {rep.pairs_compatible} compatible (both set and open)")
+    for w in rep.warnings:
+        lines.append(f"WARN {w.check} {w.subject}: {w.detail}")
+    for f in rep.failures:
+        lines.append(f"FAIL {f.check} {f.subject}: {f.detail}")
+        if f.steps and verbose:
+            lines += ["    station: " + rep.station, "    steps:"] + [f"      - {s}" for s in f.steps]
+    if rep.failures and not verbose and any(f.steps for f in rep.failures):
+        lines.append("(-v prints the steps that reproduce each failure; --format json includes them)")
+    verdict = "PASS" if rep.ok else "FAIL"
+    lines.append(f"{verdict}: {rep.checks} checks, {len(rep.failures)} failures, {len(rep.warnings)} warnings "
+                 f"({rep.routes_tested} routes, {rep.pairs_tested} pairs) in {rep.elapsed_s:.1f} s")
+    return "\n".join(lines)

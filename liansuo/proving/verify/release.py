@@ -1,0 +1,470 @@
+"""The interlocking test of one route, continued: cancel with the approach clear, manual time release with it
+occupied, sequential release behind a passing train (with the overlap timer), section fault release, the guide
+aspect, platform screen doors, and the aspects the signal shows with the onward routes set."""
+
+from __future__ import annotations
+
+from functools import partial
+from typing import TYPE_CHECKING
+
+from liansuo.interlocking.aspects import ORDER, is_open
+from liansuo.interlocking.table import Route
+from liansuo.stations.schema import SignalKind
+
+from .probe import Context, Failure, Probe, against_running, open_route, other, route_line
+
+if TYPE_CHECKING:
+    from .routes import RouteTest
+
+
+class ReleaseChecks:
+    def __init__(self, rt: RouteTest) -> None:
+        self.rt = rt
+        self.ctx = rt.ctx
+        self.r = rt.r
+        self.st = rt.ctx.station
+
+    def run(self) -> None:
+        self.cancel()
+        self.time_release()
+        self.normal_release()
+        self.flicker()
+        self.fault_release()
+        self.guide()
+        self.lamps()
+        self.doors()
+        self.aspects()
+
+    def na(self, what: str) -> None:
+        self.rt.res.not_applicable.append(what)
+
+    def all_free(self, p: Probe) -> str:
+        """'' when every section and turnout of the route is free again, else what is still locked."""
+        locked = [s for s in self.r.all_sections if p.sim.section_state(s) == "locked"]
+        locked += [f"turnout {t.id}" for t in self.r.all_turnouts if p.sim.turnout_state(t.id)[1]]
+        return ", ".join(locked)
+
+    # ---- cancel and manual time release ------------------------------------------------------------------------
+    def cancel(self) -> None:
+        r, p = self.r, Probe(self.ctx)
+        if not self.rt.opened(p, "opens"):
+            return
+        result = p.do(f"cancel {r.signal}")
+        p.run(0.5)
+        held = self.all_free(p)
+        self.rt.check(result.ok and p.closed(r.signal) and p.state(r) == "released" and not held, "cancel",
+                      f"'cancel {r.signal}' with the approach clear: {result.message}; signal shows "
+                      f"{p.aspect(r.signal)}, route {p.state(r)}" + (f", still locked: {held}" if held else ""), p)
+
+    def time_release(self) -> None:
+        r = self.r
+        if not r.approach:
+            self.na("time-release (no approach section)")
+            return
+        p = Probe(self.ctx)
+        if not self.rt.opened(p, "opens"):
+            return
+        for s in r.approach:
+            p.do(f"occupy {s}")
+        p.run(1.0)
+        result = p.do(f"cancel {r.signal}")
+        self.rt.check(not result.ok and p.state(r) != "released", "approach-locking",
+                      f"'cancel {r.signal}' with approach {', '.join(r.approach)} occupied was accepted", p)
+        result = p.do(f"release {r.signal}")
+        delay = p.sim.interlocking.release_delay(r)
+        p.run(1.0)
+        ok = result.ok and p.closed(r.signal) and p.state(r) == "time_release"
+        if not self.rt.check(ok, "time-release", f"'release {r.signal}': {result.message}; signal shows "
+                             f"{p.aspect(r.signal)}, route {p.state(r)}", p):
+            return
+        p.run(delay - 2.0)
+        held = [s for s in r.sections if p.sim.section_state(s) != "locked"]
+        if not self.rt.check(p.state(r) == "time_release" and not held, "time-release",
+                             f"{delay - 1:g} s into the {delay:g} s time release the route is {p.state(r)}"
+                             + (f", sections not locked: {', '.join(held)}" if held else ""), p):
+            return
+        p.run(2.0)
+        held_s = self.all_free(p)
+        self.rt.check(p.state(r) == "released" and not held_s and p.closed(r.signal), "time-release",
+                      f"{delay + 1:g} s after 'release {r.signal}' the route is {p.state(r)}"
+                      + (f", still locked: {held_s}" if held_s else ""), p)
+
+    # ---- a train passing: sequential release, overlap ----------------------------------------------------------
+    def normal_release(self) -> None:
+        """Occupancy moves through the approach, each route section and beyond, as a train does: the signal closes
+        as it enters (a shunting signal once the consist is past it), each section releases behind it, nothing
+        reopens, and the whole route is released at the end (the overlap after its timer)."""
+        r, p = self.r, Probe(self.ctx)
+        if not self.rt.opened(p, "opens"):
+            return
+        rs = p.sim.interlocking.routes[r.id]
+        sig, secs, beyond = r.signal, rs.sections, p.sim.interlocking.beyond(rs)  # with the run-on, if any
+        for s in r.approach:
+            p.do(f"occupy {s}")
+        p.run(1.0)
+        for i, s in enumerate(secs):
+            p.do(f"occupy {s}")
+            p.run(1.0)
+            if i == 0:
+                if r.kind == "train" and not self.rt.check(p.closed(sig), "closes-on-entry",
+                                                           f"the train entered {s}: signal {sig} still shows "
+                                                           f"{p.aspect(sig)}", p):
+                    return
+                for a in r.approach:
+                    p.do(f"vacate {a}")
+                p.run(1.0)
+                if not self.rt.check(p.closed(sig), "closes-on-entry", f"the movement is past signal {sig} "
+                                     f"(approach clear, in {s}): the signal still shows {p.aspect(sig)}", p):
+                    return
+            else:
+                p.do(f"vacate {secs[i - 1]}")
+                p.run(1.0)
+            if i == len(secs) - 1 and r.category == "receiving":
+                break  # the train stops on the receiving track
+            behind = [x for x in secs[:i] if p.sim.section_state(x) != "free"]
+            ahead = [x for x in secs[i + 1:] if p.sim.section_state(x) != "locked"]
+            if not self.rt.check(not behind and not ahead, "sequential-release",
+                                 f"train in {s}: " + "; ".join(
+                                     ([f"not released behind it: {', '.join(behind)}"] if behind else [])
+                                     + ([f"not locked ahead of it: {', '.join(ahead)}"] if ahead else [])), p):
+                return
+        if r.category != "receiving":
+            if beyond is not None:
+                p.do(f"occupy {beyond}")
+                p.run(1.0)
+            p.do(f"vacate {secs[-1]}")
+            p.run(1.0)
+        done = p.until(lambda: p.state(r) == "released", 5.0)
+        held = [s for s in secs if p.sim.section_state(s) == "locked"]
+        if not self.rt.check(done and not held, "sequential-release", f"after the train the route is {p.state(r)}"
+                             + (f", still locked: {', '.join(held)}" if held else ""), p):
+            return
+        self.rt.check(p.closed(sig), "no-automatic-reopening", f"signal {sig} shows {p.aspect(sig)} after the "
+                      "train passed", p)
+        if r.overlap_sections:
+            self.overlap(p)
+        else:
+            self.na("overlap")
+
+    def flicker(self) -> None:
+        """The three-point check (三点检查): a section that shows clear again before the next one is occupied (a
+        track circuit flickering under the train, a vehicle in a dead zone) is not released."""
+        r = self.r
+        if len(r.sections) < 2 or not r.approach:
+            self.na("three-point check (one section)")
+            return
+        p = Probe(self.ctx)
+        if not self.rt.opened(p, "opens"):
+            return
+        first, second = r.sections[0], r.sections[1]
+        for a in r.approach:
+            p.do(f"occupy {a}")
+        p.run(1.0)
+        p.do(f"occupy {first}")
+        p.run(1.0)
+        for a in r.approach:
+            p.do(f"vacate {a}")
+        p.run(1.0)
+        p.do(f"vacate {first}")
+        p.run(1.0)
+        self.rt.check(p.sim.section_state(first) == "locked", "three-point-check",
+                      f"{first} was occupied and showed clear again with {second} still clear: it was released "
+                      f"({p.sim.section_state(first)}); it must wait for the next section to be occupied", p)
+
+    def overlap(self, p: Probe) -> None:
+        r = self.r
+        held = [s for s in r.overlap_sections if p.sim.section_state(s) != "locked"]
+        if not self.rt.check(not held, "overlap", f"the train stands on {r.sections[-1]}: overlap sections not "
+                             f"locked: {', '.join(held)}", p):
+            return
+        rivals = [o for o in self.ctx.table.routes.values() if o.signal != r.signal and o.signal != r.end_signal
+                  and set(o.sections) & set(r.overlap_sections)]
+        for o in rivals[:2]:
+            result = p.do(route_line(o))
+            self.rt.check(not result.ok, "overlap", f"'{route_line(o)}' over the overlap of {r.id} while it is held: "
+                          f"{result.message}", p)
+            if result.ok:
+                p.do(f"cancel {o.signal}")
+        p.run(r.overlap_release_s - 3.0)
+        held = [s for s in r.overlap_sections if p.sim.section_state(s) != "locked"]
+        if not self.rt.check(not held, "overlap", f"overlap released early ({', '.join(held)}), before its "
+                             f"{r.overlap_release_s:g} s", p):
+            return
+        p.run(4.0)
+        held = [s for s in r.overlap_sections if p.sim.section_state(s) == "locked"]
+        held += [f"turnout {t.id}" for t in r.overlap_turnouts if p.sim.turnout_state(t.id)[1]]
+        self.rt.check(not held, "overlap", f"{r.overlap_release_s:g} s after the train stopped the overlap still "
+                      f"holds {', '.join(held)}", p)
+
+    def fault_release(self) -> None:
+        """Section fault release (区故解) of the locked clear sections ahead of a train that entered the route:
+        granted at once, refused on a station track and on the occupied section."""
+        r = self.r
+        if len(r.sections) < 2:
+            self.na("fault-release (one section)")
+            return
+        p = Probe(self.ctx)
+        if not self.rt.opened(p, "opens"):
+            return
+        for a in r.approach:
+            p.do(f"occupy {a}")
+        p.run(1.0)
+        p.do(f"occupy {r.sections[0]}")
+        p.run(1.0)
+        for a in r.approach:
+            p.do(f"vacate {a}")
+        p.run(1.0)
+        result = p.do(f"fault-release {r.sections[0]}")
+        self.rt.check(not result.ok, "fault-release", f"'fault-release {r.sections[0]}' of the occupied section "
+                      f"was accepted: {result.message}", p)
+        for s in r.sections[1:]:
+            result = p.do(f"fault-release {s}")
+            if self.st.is_station_track(s):
+                self.rt.check(not result.ok and p.sim.section_state(s) == "locked", "fault-release",
+                              f"'fault-release {s}' on a station track: {result.message}", p)
+            else:
+                self.rt.check(result.ok and p.sim.section_state(s) == "free", "fault-release",
+                              f"'fault-release {s}': {result.message}; the section is {p.sim.section_state(s)}", p)
+
+    # ---- guide, doors --------------------------------------------------------------------------------------------
+    def guide(self) -> None:
+        """Guide aspect HB (引导) over a track-circuit fault on the route: shown with the route locked, closed once
+        the guided train has passed."""
+        r, sig = self.r, self.st.signals[self.r.signal]
+        if r.kind != "train" or sig.kind not in (SignalKind.home, SignalKind.route) or \
+                "B" not in [lamp.value for lamp in sig.lamps] or len(r.sections) < 2:
+            self.na("guide")
+            return
+        p = Probe(self.ctx)
+        if not self.rt.opened(p, "opens"):
+            return
+        faulty = r.sections[-1]
+        p.do(f"occupy {faulty}")
+        p.run(1.0)
+        if r.turnouts:  # a guide route still needs every turnout in position with its indication
+            t = r.turnouts[0].id
+            p.do(f"fault no-indication {t}")
+            p.run(1.0)
+            result = p.do(f"guide {r.signal}")
+            p.run(1.0)
+            self.rt.check(not result.ok and not p.is_open(r.signal), "guide", f"'guide {r.signal}' with turnout {t} "
+                          f"of the route without indication: {result.message}; the signal shows "
+                          f"{p.aspect(r.signal)}", p)
+            p.do(f"repair no-indication {t}")
+            p.run(1.0)
+        result = p.do(f"guide {r.signal}")
+        p.run(1.0)
+        if not self.rt.check(result.ok and p.aspect(r.signal) == "HB", "guide",
+                             f"'guide {r.signal}' with {faulty} showing occupied: {result.message}; the signal "
+                             f"shows {p.aspect(r.signal)}", p):
+            return
+        loose = [t.id for t in r.all_turnouts if not p.sim.turnout_state(t.id)[1]]
+        self.rt.check(not loose, "guide", f"turnouts not locked under the guide aspect: {', '.join(loose)}", p)
+        doors = self.door_platforms()
+        if doors:  # the guide aspect checks the screen doors like any other: a door failing closes it
+            q = Probe(self.ctx)
+            if self.rt.opened(q, "opens"):
+                q.do(f"occupy {faulty}")
+                q.run(1.0)
+                q.do(f"guide {r.signal}")
+                q.run(1.0)
+                q.do(f"fault psd-stuck {doors[0]}")
+                q.run(1.0)
+                self.rt.check(q.aspect(r.signal) != "HB", "guide", f"screen door of {doors[0]} failed open under "
+                              f"the guide aspect: {r.signal} still shows HB", q)
+        for a in r.approach:
+            p.do(f"occupy {a}")
+        p.run(1.0)
+        self.rt.check(p.aspect(r.signal) == "HB", "guide", f"the guided train approaches {r.signal}: it shows "
+                      f"{p.aspect(r.signal)}", p)
+        p.do(f"occupy {r.sections[0]}")
+        p.run(0.5)
+        self.rt.check(p.closed(r.signal), "guide", f"the guided train entered {r.sections[0]} (its tail still in the "
+                      f"approach): {r.signal} still shows {p.aspect(r.signal)}", p)
+
+    def lamps(self) -> None:
+        """A lamp of the aspect shown goes dark (both filaments): the interlocking commands a more restrictive
+        aspect (the rule set's downgrade), never keeps the one it can no longer show."""
+        r = self.r
+        p = Probe(self.ctx)
+        if not self.rt.opened(p, "opens"):
+            return
+        shown = p.aspect(r.signal)
+        lamps = [lamp for lamp in self.ctx.rules.lamps.get(shown, [])
+                 if lamp in {x.value for x in self.st.signals[r.signal].lamps}]
+        if not lamps:
+            return
+        lamp = lamps[0]
+        p.do(f"fault filament {r.signal} lamp={lamp} which=both")
+        p.run(1.0)
+        after = p.aspect(r.signal)
+        self.rt.check(after != shown and ORDER.get(after, 0) <= ORDER.get(shown, 0), "lamp-proving",
+                      f"lamp {lamp} of {r.signal} dark while it showed {shown}: the interlocking commands {after}", p)
+
+    def door_platforms(self) -> list[str]:
+        rear = self.st.signal_rear_track(self.r.signal)
+        rear_section = self.st.tracks[rear].section if rear else None
+        return [pl.id for pl in self.st.model.platforms if pl.screen_doors
+                and (pl.section in self.r.sections or pl.section == rear_section)]
+
+    def doors(self) -> None:
+        """Platform screen doors (站台门): a door stuck open keeps the signal closed; the bypass (互锁解除) lets it
+        open; a door failing while the signal is open closes it."""
+        r = self.r
+        platforms = self.door_platforms()
+        if not platforms:
+            self.na("doors")
+            return
+        for pl in platforms:
+            p = Probe(self.ctx)
+            p.do(f"fault psd-stuck {pl}")
+            open_route(p, r, timeout_s=20.0)
+            self.rt.check(p.closed(r.signal) and p.state(r) == "locked", "doors",
+                          f"screen door of {pl} stuck open: signal {r.signal} shows {p.aspect(r.signal)}, route "
+                          f"{p.state(r)}", p)
+            p.do(f"fault psd-bypass {pl}")
+            ok = p.until(partial(p.is_open, r.signal), 5.0)
+            self.rt.check(ok, "doors", f"with {pl}'s interlock bypass on, signal {r.signal} stays closed: "
+                          f"{p.blocker(r)}", p)
+            p = Probe(self.ctx)
+            if not self.rt.opened(p, "opens"):
+                continue
+            p.do(f"fault psd-stuck {pl}")
+            p.run(1.0)
+            self.rt.check(p.closed(r.signal), "doors", f"screen door of {pl} failed open: signal {r.signal} still "
+                          f"shows {p.aspect(r.signal)}", p)
+
+    # ---- aspects with the onward routes ---------------------------------------------------------------------------
+    def aspects(self) -> None:
+        """Set each onward route from the end signal (and vary the block sections ahead): every aspect shown is one
+        the table lists; the ones shown are reported. USU degrades to UU when an electronic flasher fails."""
+        r = self.r
+        if r.kind != "train":
+            return
+        table = self.ctx.table
+        onward = [o for o in table.routes.values()
+                  if o.kind == "train" and r.end_signal and o.signal == r.end_signal and o.id not in r.conflicts]
+        if r.category == "departure":
+            p = Probe(self.ctx)
+            if self.rt.opened(p, "opens"):
+                self.vary_blocks(p, r.exit_link, r)
+        for o in onward:
+            p = Probe(self.ctx)
+            if not open_route(p, r, o):
+                self.rt.check(False, "onward", f"'{route_line(r)}' with onward route {o.id}: {p.blocker(r)}; "
+                              f"{p.blocker(o)}", p)
+                continue
+            self.seen(p)
+            if p.aspect(r.signal) == "USU":
+                self.flasher(p)
+            if o.category == "departure":
+                p = Probe(self.ctx)
+                if open_route(p, r, o):
+                    self.vary_blocks(p, o.exit_link, o)
+
+    def seen(self, p: Probe) -> None:
+        r = self.r
+        shown = p.aspect(r.signal)
+        if is_open(shown):
+            self.rt.res.aspects_seen.add(shown)
+        self.rt.check(shown in r.aspects, "aspect", f"signal {r.signal} shows {shown}; the table gives "
+                      f"{'/'.join(r.aspects)}", p)
+
+    def vary_blocks(self, p: Probe, link_id: str | None, departure: Route) -> None:
+        """Occupy the third, then the second block section beyond a departure: the departure signal shows LU, then U
+        (four-aspect automatic block); the route under test follows."""
+        link = next((lk for lk in self.st.model.links if lk.id == link_id), None)
+        if link is None or link.kind.value != "automatic":
+            return
+        signal = departure.signal
+        if against_running(self.st, link.id):
+            # worked against its running direction (改方) the line is one block: any section occupied closes it
+            p.do(f"occupy {link.sections[-1]}")
+            p.run(1.0)
+            self.rt.check(p.closed(signal), "aspect", f"line {link.id} worked against its running direction is one "
+                          f"block: with {link.sections[-1]} occupied {signal} shows {p.aspect(signal)}", p)
+            return
+        for n, s in ((2, link.sections[2:3]), (1, link.sections[1:2])):
+            if not s:
+                continue
+            p.do(f"occupy {s[0]}")
+            p.run(1.0)
+            self.seen(p)
+            want = {2: "LU", 1: "U"}[n]
+            self.rt.check(p.aspect(signal) == want, "aspect", f"{n} clear block section(s) beyond {signal}: it "
+                          f"shows {p.aspect(signal)}, expected {want}", p)
+
+    def flasher(self, p: Probe) -> None:
+        r = self.r
+        relay = self.st.signals[r.signal].flasher == "relay"
+        p.do(f"fault flasher {r.signal}")
+        p.run(4.0)
+        shown = p.aspect(r.signal)
+        if relay:
+            self.ctx.record(True, "flasher", r.id, "")
+            if shown == "USU":
+                self.ctx.warnings.append(Failure(
+                    "flasher", r.id, f"signal {r.signal} has a relay flasher (SNJ/SNJJ): a bad SNJ contact darkens the "
+                    "flashing lamp and the interlocking keeps commanding USU (see docs/faults.md)", p.script()))
+            return
+        self.rt.check(shown == "UU", "flasher", f"USU flasher of {r.signal} failed: the signal shows {shown}, "
+                      "expected UU", p)
+
+
+def throat_checks(ctx: Context) -> None:
+    """Guide total lock (引导总锁闭) of each throat: every turnout of the throat locked (individual operation
+    refused), the guide aspect HB without a route, and everything free again after the unlock."""
+    st = ctx.station
+    for throat, turnouts in ctx.table.throats.items():
+        subject = f"throat {throat}"
+        p = Probe(ctx)
+        result = p.do(f"guide-lock {throat}")
+        if not ctx.record(result.ok, "guide-lock", subject, f"'guide-lock {throat}': {result.message}", p):
+            continue
+        for t in turnouts:
+            pos = p.sim.turnout_state(t)[0] or "normal"
+            result = p.do(f"throw {t} {other(pos)}")
+            ctx.record(not result.ok, "guide-lock", subject, f"turnout {t} could be thrown under guide total lock: "
+                       f"{result.message}", p)
+        sig = st.signals.get(throat)
+        if sig is not None and "B" in [lamp.value for lamp in sig.lamps]:
+            result = p.do(f"guide {throat}")
+            p.run(1.0)
+            ctx.record(result.ok and p.aspect(throat) == "HB", "guide-lock", subject,
+                       f"'guide {throat}' under guide total lock: {result.message}; the signal shows "
+                       f"{p.aspect(throat)}", p)
+            for pl in _bordering_platforms(ctx, throat):
+                # the way is not known under guide total lock: a door failing at any platform the throat leads
+                # to closes the guide aspect, and it cannot be given again while the door is open
+                p.do(f"fault psd-stuck {pl}")
+                p.run(1.0)
+                again = p.do(f"guide {throat}")
+                ctx.record(p.aspect(throat) != "HB" and not again.ok, "guide-lock", subject,
+                           f"screen door of {pl} failed open under guide total lock: {throat} shows "
+                           f"{p.aspect(throat)}, 'guide {throat}' {'accepted' if again.ok else 'refused'}", p)
+                p.do(f"repair psd-stuck {pl}")
+                p.run(1.0)
+            p.do(f"cancel {throat}")
+        result = p.do(f"guide-unlock {throat}")
+        loose = result.ok and not any(p.sim.turnout_state(t)[1] for t in turnouts)
+        ctx.record(loose, "guide-lock", subject, f"'guide-unlock {throat}': {result.message}", p)
+
+
+def _bordering_platforms(ctx: Context, signal: str) -> list[str]:
+    """Platforms with screen doors whose track borders the throat ``signal`` leads into (the throat: the tracks
+    reached from the signal without entering a station track or the line), found on the track layout."""
+    st = ctx.station
+    inner = {"throat", "spur"}
+    start = st.signal_entry_track(signal)
+    seen, todo, touched = {start}, [start], set()
+    while todo:
+        for port in st.track_ports[todo.pop()]:
+            for _, nxt in st.node_tracks[port.node]:
+                if nxt in seen:
+                    continue
+                seen.add(nxt)
+                sec = st.tracks[nxt].section
+                touched.add(sec)
+                if st.sections[sec].role.value in inner:
+                    todo.append(nxt)
+    return [pl.id for pl in st.model.platforms if pl.screen_doors and pl.section in touched]

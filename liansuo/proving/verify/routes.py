@@ -1,0 +1,272 @@
+"""The interlocking test (联锁试验) of one route, item by item as on a real test record (DOMAIN.md section 3): the
+signal opens with an aspect of the table; turnouts move and lock; it cannot open with a turnout out of position or
+without indication, or with a section occupied, and closes when any of these is lost; it never reopens by itself.
+Release, guide, doors and aspects are in :mod:`.release`.
+
+Each check runs on a fresh simulation (a :class:`~.probe.Probe`) and is recorded in the :class:`~.probe.Context`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from liansuo.interlocking.aspects import ORDER
+from liansuo.interlocking.table import Route
+from liansuo.stations.schema import SectionRole
+
+from ..oracle.authority import Tracer
+from .probe import Context, Probe, against_running, open_route, other, prepare, route_line, turnout_groups
+
+_LINE = (SectionRole.approach, SectionRole.departure, SectionRole.block)
+SETTLE_S = 20.0  # long enough for any turnout move (the slowest machine 6.6 s, two batches) and a 64D acceptance
+
+
+@dataclass
+class RouteResult:
+    id: str
+    checks: int = 0
+    failures: int = 0
+    aspects_seen: set[str] = field(default_factory=set)
+    not_applicable: list[str] = field(default_factory=list)
+
+    def as_dict(self, aspects: tuple[str, ...]) -> dict[str, object]:
+        order = {a: i for i, a in enumerate(("L", "LL", "LU", "USU", "UU", "U", "B"))}
+        return {"id": self.id, "checks": self.checks, "failures": self.failures,
+                "aspects_table": list(aspects),
+                "aspects_seen": sorted(self.aspects_seen, key=lambda a: order.get(a, 99)),
+                "not_applicable": list(self.not_applicable)}
+
+
+class RouteTest:
+    """All checks of one route; ``run()`` returns its tally."""
+
+    def __init__(self, ctx: Context, r: Route) -> None:
+        self.ctx = ctx
+        self.r = r
+        self.res = RouteResult(r.id)
+
+    def check(self, ok: bool, check: str, detail: str, p: Probe | None = None) -> bool:
+        self.res.checks += 1
+        if not ok:
+            self.res.failures += 1
+        return self.ctx.record(ok, check, self.r.id, detail, p)
+
+    def opened(self, p: Probe, check: str) -> bool:
+        """Open the route on a fresh probe; a failure to open is recorded under ``check``."""
+        ok = open_route(p, self.r)
+        if ok:
+            self.res.aspects_seen.add(p.aspect(self.r.signal))
+        return self.check(ok, check, f"signal {self.r.signal} did not open: {p.blocker(self.r)}", p)
+
+    def run(self) -> RouteResult:
+        from .release import ReleaseChecks
+
+        self.opens_from_the_other_positions()
+        self.liaison()
+        for t, pos in turnout_groups(self.ctx.station, self.r):
+            self.turnout_out_of_position(t, pos)
+            self.turnout_obstructed(t, pos)
+        for rt in self.r.all_turnouts:
+            self.no_indication(rt.id)
+        for s in self.r.all_sections:
+            self.section_occupied(s)
+        ReleaseChecks(self).run()
+        return self.res
+
+    # ---- opening ------------------------------------------------------------------------------------------------
+    def opens_from_the_other_positions(self) -> None:
+        """Every route, protection and driven turnout starts the other way: selecting the route moves them all,
+        locks them, locks the sections, and the signal opens with one of the table's aspects."""
+        r, p, st = self.r, Probe(self.ctx), self.ctx.station
+        for t, pos in turnout_groups(st, r):
+            p.do(f"throw {t} {other(pos)}")
+        p.until(lambda: all(p.sim.turnout_state(t)[0] == other(pos) for t, pos in turnout_groups(st, r)), SETTLE_S)
+        if not self.opened(p, "opens"):
+            return
+        shown = p.aspect(r.signal)
+        self.check(shown in r.aspects, "aspect", f"signal {r.signal} shows {shown}; the table gives "
+                   f"{'/'.join(r.aspects)}", p)
+        if r.end_signal and r.kind == "train":
+            # the signal ahead is closed: prepare to stop, the least permissive aspect the table gives
+            least = min(r.aspects, key=lambda a: ORDER.get(a, 0))
+            self.check(shown == least, "aspect", f"signal {r.signal} shows {shown} with {r.end_signal} ahead "
+                       f"closed; expected {least}", p)
+        for rt in r.all_turnouts:
+            at, locked = p.sim.turnout_state(rt.id)
+            self.check(at == rt.position.value and locked, f"{rt.role}-turnout",
+                       f"{rt.role} turnout {rt.id} is {at or 'without indication'}"
+                       f"{' and locked' if locked else ' and not locked'}; the route needs it {rt.position.value} "
+                       "and locked", p)
+        for s in r.all_sections:
+            self.check(p.sim.section_state(s) == "locked", "section-locked",
+                       f"section {s} is {p.sim.section_state(s)} with the signal open", p)
+        for t, pos in turnout_groups(st, r):
+            result = p.do(f"throw {t} {other(pos)}")
+            p.run(1.0)
+            self.check(not result.ok and p.sim.turnout_state(t)[0] == pos and p.is_open(r.signal), "turnout-locked",
+                       f"'throw {t} {other(pos)}' with the signal open: {result.message}; turnout {t} is "
+                       f"{p.sim.turnout_state(t)[0]}, signal {r.signal} shows {p.aspect(r.signal)}", p)
+
+    def liaison(self) -> None:
+        """A departure's signal stays closed without the liaison: 64D without the neighbour's acceptance or with the
+        line's departure section occupied, automatic block with the first block section occupied; it opens once the
+        liaison is there."""
+        r = self.r
+        il_links = self.ctx.station.model.links
+        link = next((lk for lk in il_links if lk.id == r.exit_link), None)
+        if link is None:
+            self.line_without_block()
+            return
+        p = Probe(self.ctx)
+        if link.kind.value == "64d":
+            p.do(route_line(r))
+            p.run(SETTLE_S)
+            self.check(p.closed(r.signal) and p.state(r) == "locked", "liaison",
+                       f"64D departure: signal {r.signal} shows {p.aspect(r.signal)} without the neighbour's "
+                       "acceptance", p)
+            # a train (or a red band) in the line's departure section: no block, the signal stays closed
+            line = link.sections[0]
+            p.do(f"occupy {line}")
+            result = p.do(f"block-line {link.id} request")
+            p.run(SETTLE_S)
+            self.check(not result.ok and p.closed(r.signal), "liaison",
+                       f"64D departure with {line} occupied: 'block-line {link.id} request' was "
+                       f"{'accepted' if result.ok else 'refused'} and {r.signal} shows {p.aspect(r.signal)}", p)
+            p.do(f"block-line {link.id} cancel")
+            p.do(f"vacate {line}")
+            p.run(1.0)
+            prepare(p, r)
+        elif against_running(self.ctx.station, link.id):
+            # against the line's running direction: refused until the direction is changed (改方), which a line that
+            # is not bidirectional never allows
+            result = p.do(route_line(r))
+            self.check(not result.ok and "direction" in result.message, "line-direction",
+                       f"'{route_line(r)}' against the running direction of line {link.id} without a direction "
+                       f"change was {'accepted' if result.ok else 'refused: ' + result.message}", p)
+            if not link.bidirectional:
+                self.res.not_applicable.append("liaison (line not bidirectional)")
+                return
+            prepare(p, r)
+            p.do(route_line(r))
+        else:
+            beyond = [s for s in link.sections if s not in r.sections]
+            if not beyond:  # the route itself runs over the line's sections to the boundary
+                self.res.not_applicable.append("liaison (the block sections are the route's own)")
+                return
+            self.closed_while_occupied(p, beyond[0], "automatic block", "the first block section")
+        ok = p.until(lambda: p.state(r) == "open", SETTLE_S)
+        self.check(ok, "liaison", f"signal {r.signal} did not open once the liaison was given: {p.blocker(r)}", p)
+
+    def line_without_block(self) -> None:
+        """A departure onto a line the station file gives no block system: the movement's authority (traced on the
+        layout) runs on over the line's sections, so the signal stays closed while one of them is occupied."""
+        r = self.r
+        st = self.ctx.station
+        if r.kind != "train":
+            self.res.not_applicable.append("liaison")
+            return
+        lies = {t.id: t.position.value for t in r.all_turnouts}
+        a = Tracer(st).trace(r.signal, "train", lies.get)
+        line = [s for s in a.sections if s not in r.sections and st.sections[s].role in _LINE]
+        if not line:
+            self.res.not_applicable.append("liaison")
+            return
+        p = Probe(self.ctx)
+        self.closed_while_occupied(p, line[0], "departure onto a line without block", "line section")
+        ok = p.until(lambda: p.state(r) == "open", SETTLE_S)
+        self.check(ok, "liaison", f"signal {r.signal} did not open once {line[0]} was clear: {p.blocker(r)}", p)
+
+    def closed_while_occupied(self, p: Probe, section: str, case: str, what: str) -> None:
+        """The departure is set with ``section`` beyond it occupied: its signal stays closed; then it clears."""
+        r = self.r
+        p.do(f"occupy {section}")
+        p.do(route_line(r))
+        p.run(SETTLE_S)
+        self.check(p.closed(r.signal), "liaison", f"{case}: signal {r.signal} shows {p.aspect(r.signal)} with "
+                   f"{what} {section} occupied", p)
+        p.do(f"vacate {section}")
+
+    # ---- turnouts -----------------------------------------------------------------------------------------------
+    def turnout_out_of_position(self, t: str, pos: str) -> None:
+        """A turnout lying the other way and single-locked there: the route cannot be set."""
+        r, p = self.r, Probe(self.ctx)
+        p.do(f"throw {t} {other(pos)}")
+        p.until(lambda: p.sim.turnout_state(t)[0] == other(pos), SETTLE_S)
+        p.do(f"lock {t}")
+        result = p.do(route_line(r))
+        p.run(SETTLE_S)
+        self.check(not result.ok and p.closed(r.signal), "turnout-out-of-position",
+                   f"turnout {t} single-locked {other(pos)}: '{route_line(r)}' was "
+                   f"{'accepted' if result.ok else 'refused'} and signal {r.signal} shows {p.aspect(r.signal)}", p)
+
+    def turnout_obstructed(self, t: str, pos: str) -> None:
+        """A turnout that cannot reach its position (4 mm obstruction): the route stays unlocked, the signal closed."""
+        r, p = self.r, Probe(self.ctx)
+        p.do(f"throw {t} {other(pos)}")
+        p.until(lambda: p.sim.turnout_state(t)[0] == other(pos), SETTLE_S)
+        p.do(f"fault obstruction {t}")
+        prepare(p, r)
+        p.do(route_line(r))
+        p.run(SETTLE_S)
+        self.check(p.closed(r.signal), "turnout-obstructed", f"turnout {t} obstructed on its way {pos}: signal "
+                   f"{r.signal} shows {p.aspect(r.signal)}", p)
+
+    def no_indication(self, t: str) -> None:
+        """Without indication the signal cannot open; losing it closes the open signal, which stays closed after
+        the repair until the operator reopens it (重复开放)."""
+        r = self.r
+        p = Probe(self.ctx)
+        p.do(f"fault no-indication {t}")
+        open_route(p, r, timeout_s=SETTLE_S)
+        self.check(p.closed(r.signal), "no-indication", f"turnout {t} without indication: signal {r.signal} shows "
+                   f"{p.aspect(r.signal)}", p)
+        p = Probe(self.ctx)
+        if not self.opened(p, "opens"):
+            return
+        self.closes_until_reopened(p, "no-indication", f"fault no-indication {t}", f"turnout {t} lost its indication",
+                                   f"repair no-indication {t}", f"turnout {t}'s indication came back")
+
+    def closes_until_reopened(self, p: Probe, check: str, cause: str, what: str, repair: str, repaired: str) -> None:
+        """On an open signal: ``cause`` closes it with an alarm; after ``repair`` it stays closed until the operator
+        reopens it (重复开放)."""
+        sig = self.r.signal
+        p.do(cause)
+        p.run(1.0)
+        if not self.check(p.closed(sig), check, f"{what}: signal {sig} still shows {p.aspect(sig)}", p):
+            return
+        self.closing_alarm(p)
+        p.do(repair)
+        p.run(5.0)
+        if not self.check(p.closed(sig), "no-automatic-reopening", f"signal {sig} reopened by itself "
+                          f"({p.aspect(sig)}) after {repaired}", p):
+            return
+        result = p.do(f"reopen {sig}")
+        p.run(1.0)
+        self.check(result.ok and p.is_open(sig), "reopen", f"'reopen {sig}' after {repaired}: {result.message}; "
+                   f"signal shows {p.aspect(sig)}", p)
+
+    def closing_alarm(self, p: Probe) -> None:
+        """A signal closed abnormally raises an alarm (非正常关闭报警)."""
+        sig = self.r.signal
+        alarms = p.sim.alarm_texts()
+        self.check(any(f"signal {sig} closed" in a for a in alarms), "closing-alarm",
+                   f"signal {sig} closed abnormally without an alarm (alarms: {'; '.join(alarms) or 'none'})", p)
+
+    # ---- sections -----------------------------------------------------------------------------------------------
+    def section_occupied(self, s: str) -> None:
+        """An occupied route, fouling or overlap section: the route cannot be set; occupied while open, the signal
+        closes and stays closed after the section clears, until reopened."""
+        r = self.r
+        p = Probe(self.ctx)
+        p.do(f"occupy {s}")
+        prepare(p, r)
+        result = p.do(route_line(r))
+        p.run(SETTLE_S)
+        self.check(not result.ok and p.closed(r.signal), "section-occupied",
+                   f"section {s} occupied: '{route_line(r)}' was {'accepted' if result.ok else 'refused'} and "
+                   f"signal {r.signal} shows {p.aspect(r.signal)}", p)
+        p = Probe(self.ctx)
+        if not self.opened(p, "opens"):
+            return
+        self.closes_until_reopened(p, "section-occupied", f"occupy {s}", f"section {s} occupied", f"vacate {s}",
+                                   f"section {s} cleared")

@@ -1,0 +1,16 @@
+"""The world around the interlocking: clock, field, command language, scripts, CLI.
+
+Python API::
+
+    from liansuo.simulation import Simulation
+    sim = Simulation("jiaopei")          # a bundled name or a path to a station file
+    result = sim.command("route X XI")   # Result(ok=True, message='route X-XI selected')
+    sim.run(5)                           # advance simulated time by 5 s
+    sim.aspect("X")                      # 'U'
+"""
+
+from liansuo.interlocking.io import Result
+
+from .sim import Simulation
+
+__all__ = ["Result", "Simulation"]

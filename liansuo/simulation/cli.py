@@ -1,0 +1,171 @@
+"""The ``liansuo`` command line."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from collections.abc import Callable, Sequence
+
+from liansuo.stations.library import bundled, describe
+from liansuo.stations.loader import load
+from liansuo.stations.schema import StationFile
+from liansuo.stations.source import StationError
+from liansuo.stations.summary import summarise, summary_text
+
+Handler = Callable[[argparse.Namespace], int]
+
+
+def _print_errors(exc: StationError) -> int:
+    for d in exc.diagnostics:
+        print(d, file=sys.stderr)
+    n = len(exc.diagnostics)
+    print(f"{n} error{'s' if n != 1 else ''}; the station was not loaded", file=sys.stderr)
+    return 1
+
+
+def cmd_stations(args: argparse.Namespace) -> int:
+    for name, path in bundled().items():
+        print(f"{name:10} {describe(path)}")
+    return 0
+
+
+def cmd_check(args: argparse.Namespace) -> int:
+    try:
+        station = load(args.station)
+    except StationError as exc:
+        if args.format == "json":
+            print(json.dumps({"station": args.station, "ok": False,
+                              "errors": [d.as_dict() for d in exc.diagnostics]}, ensure_ascii=False, indent=2))
+            return 1
+        return _print_errors(exc)
+    if args.format == "json":
+        print(json.dumps({"ok": True, **summarise(station)}, ensure_ascii=False, indent=2))
+    else:
+        print(summary_text(station))
+    return 0
+
+
+def cmd_schema(args: argparse.Namespace) -> int:
+    schema = StationFile.model_json_schema(by_alias=True)
+    schema["$schema"] = "https://json-schema.org/draft/2020-12/schema"
+    schema["title"] = "liansuo station file"
+    print(json.dumps(schema, ensure_ascii=False, indent=2))
+    return 0
+
+
+def cmd_table(args: argparse.Namespace) -> int:
+    from liansuo.interlocking.table import build_table
+    from liansuo.interlocking.tableformat import as_csv, as_json, as_text
+
+    try:
+        table = build_table(load(args.station))
+    except StationError as exc:
+        return _print_errors(exc)
+    print({"text": as_text, "csv": as_csv, "json": as_json}[args.format](table), end="" if args.format == "csv"
+          else "\n")
+    return 0
+
+
+def cmd_run(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from .scenario import parse_scenario, run_scenario
+    from .timeparse import parse_duration
+
+    try:
+        sc = parse_scenario(Path(args.scenario))
+    except StationError as exc:
+        return _print_errors(exc)
+    until = None
+    if args.until:
+        try:
+            until = parse_duration(args.until)
+        except ValueError as exc:
+            print(f"--until: {exc}", file=sys.stderr)
+            return 2
+    from .trains.sumo import SumoEngineError
+    from .trains.sumo_export import SumoExportError, SumoUnavailable
+
+    try:
+        status, sim = run_scenario(sc, until, engine=args.engine)
+    except StationError as exc:
+        return _print_errors(exc)
+    except (SumoUnavailable, SumoExportError, SumoEngineError) as exc:  # the SUMO engine could not start
+        print(f"liansuo run --engine {args.engine}: {exc}", file=sys.stderr)
+        return 2
+    sim.close()
+    return status
+
+
+def cmd_bench(args: argparse.Namespace) -> int:
+    from .bench import main as bench_main
+
+    return bench_main(quick=args.quick, fmt=args.format)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="liansuo", description="Station signalling and interlocking simulator (联锁)")
+    sub = p.add_subparsers(dest="command", metavar="COMMAND")
+
+    def add(name: str, handler: Handler, help_: str) -> argparse.ArgumentParser:
+        sp = sub.add_parser(name, help=help_, description=help_)
+        sp.set_defaults(handler=handler)
+        return sp
+
+    add("stations", cmd_stations, "list the bundled stations")
+    sp = add("check", cmd_check, "validate a station file and summarise it")
+    sp.add_argument("station", help="bundled station name or path to a station YAML file")
+    sp.add_argument("--format", choices=("text", "json"), default="text")
+    add("schema", cmd_schema, "print the JSON Schema of the station format")
+    sp = add("table", cmd_table, "print the interlocking table (联锁表) derived from the topology")
+    sp.add_argument("station", help="bundled station name or path")
+    sp.add_argument("--format", choices=("text", "csv", "json"), default="text")
+    sp = add("bench", cmd_bench, "benchmark table building and the interlocking cycle (hub and jiaopei)")
+    sp.add_argument("--quick", action="store_true", help="fewer cycles (under a minute)")
+    sp.add_argument("--format", choices=("json", "text"), default="json")
+    sp = add("run", cmd_run, "run a scenario headless and print the event log")
+    sp.add_argument("scenario", help="scenario YAML file")
+    sp.add_argument("--until", metavar="DURATION", help="keep running to this simulated time (e.g. 10min)")
+    sp.add_argument("--engine", choices=("kinematic", "sumo"), default="kinematic",
+                    help="what moves the trains: the built-in kinematic model (default) or Eclipse SUMO "
+                         "(pip install 'liansuo[sumo]'; see docs/sumo.md)")
+    from .zpwcli import register as register_zpw
+
+    register_zpw(add)
+    _register_plugins(add)
+    return p
+
+
+def _register_plugins(add: Callable[..., argparse.ArgumentParser]) -> None:
+    """Subcommands of the layers above (proving: ``liansuo test``, ``verify``, ``soak``; the console: ``liansuo
+    tui``, ``replay``), found through the ``liansuo.commands`` entry-point group so this module never imports
+    them."""
+    from importlib.metadata import entry_points
+
+    for ep in entry_points(group="liansuo.commands"):
+        try:
+            register = ep.load()
+        except ImportError as exc:  # a broken plugin must not take the rest of the command line down
+            print(f"liansuo: subcommand '{ep.name}' unavailable: {exc}", file=sys.stderr)
+            continue
+        register(add)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    handler: Handler | None = getattr(args, "handler", None)
+    if handler is None:
+        parser.print_help()
+        return 2
+    try:
+        return handler(args)
+    except BrokenPipeError:  # e.g. piped into head
+        return 0
+    except KeyboardInterrupt:
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,62 @@
+"""The wires between the trackside field and the interlocking: commands out, relays in.
+
+Only what changed crosses: the interlocking's changed aspects become lamp commands, the field's changed relays are
+copied onto the interlocking's relay board.
+"""
+
+from __future__ import annotations
+
+from liansuo.circuits.field import Field, FieldCommands
+from liansuo.interlocking.io import Outputs, RelayBoard
+from liansuo.interlocking.rules import RuleSet
+from liansuo.stations.station import Station
+
+
+class Wiring:
+    def __init__(self, station: Station, rules: RuleSet, field: Field) -> None:
+        self.station = station
+        self.rules = rules
+        self.field = field
+        self.commands = FieldCommands()
+        self.signal_lamps = {s.id: {lamp.value for lamp in s.lamps} for s in station.model.signals}
+        self._lit = False  # the first commands light every signal's lamps (the aspects set before any cycle)
+
+    def relight(self) -> None:
+        """Send every signal's lamps again with the next commands (a new interlocking has taken over)."""
+        self._lit = False
+
+    def commands_from(self, out: Outputs) -> FieldCommands:
+        cmd = self.commands
+        cmd.drives = out.turnouts
+        changed = out.changed_signals if self._lit else set(out.signals)
+        self._lit = True
+        for sig in changed:
+            aspect = out.signals.get(sig, "")
+            cmd.lamps[sig] = set(self.rules.lamps.get(aspect, [])) & self.signal_lamps[sig]
+            if aspect == "USU":
+                cmd.flashing.add(sig)
+            else:
+                cmd.flashing.discard(sig)
+            cmd.changed_signals.add(sig)
+        cmd.doors = {k: (d.zckj, d.kmj, d.gmj) for k, d in out.doors.items()}
+        cmd.cab_codes = out.cab_codes
+        return cmd
+
+    def publish(self, board: RelayBoard, everything: bool = False) -> None:
+        f = self.field
+        ch = f.take_changes()
+        tracks = self.station.sections if everything else ch.tracks
+        for s in tracks:
+            board.set_track(s, f.track_up(s))
+        for t in (self.station.turnouts if everything else ch.turnouts):
+            dbj, fbj = f.indication(t)
+            board.set_turnout(t, dbj, fbj)
+        for sig in (self.station.signals if everything else ch.signals):
+            for lamp in self.signal_lamps[sig]:
+                board.set_lamp(sig, lamp, f.lamp_proven(sig, lamp))
+            if sig in f.flashers:
+                board.set_flasher(sig, f.flasher_ok(sig))
+            board.set_filament_alarm(sig, f.filament_alarm(sig))
+        for key in (f.doors if everything else ch.doors):
+            pdkj, pdqcj = f.doors_relays(key)
+            board.set_doors(key, pdkj, pdqcj)

@@ -1,0 +1,160 @@
+"""``liansuo zpw STATION``: the ZPW-2000A figures of every section (adjustment, worst shunt residual, minimum cab
+current), optionally with compensation-capacitor faults. The model is ``circuits.zpw2000a``; see docs/zpw2000a.md."""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import sys
+from collections.abc import Callable, Sequence
+from typing import Any
+
+from liansuo.stations.loader import load
+from liansuo.stations.source import StationError
+from liansuo.stations.station import Station
+
+COLUMNS = ("id", "carrier", "length_m", "capacitors", "adjustment_mV", "max_shunt_residual_mV",
+           "min_cab_current_mA", "cab_min_mA", "relay", "fault")
+MODES = ("open", "half", "short")
+FAULT_FORM = "SECTION:capacitor:N:open|half|short"
+
+
+class FaultSpecError(ValueError):
+    """A --fault argument that cannot be applied; the message is one line."""
+
+
+def parse_fault(text: str) -> tuple[str, int, str]:
+    """``'X2JG:capacitor:3:open'`` -> ('X2JG', 3, 'open')."""
+    parts = text.split(":")
+    if len(parts) != 4 or parts[1].lower() != "capacitor":
+        raise FaultSpecError(f"--fault '{text}': write {FAULT_FORM}, e.g. X2JG:capacitor:3:open")
+    section, _, number, mode = parts
+    if not number.isdigit() or int(number) < 1:
+        raise FaultSpecError(f"--fault '{text}': the capacitor number must be a whole number from 1")
+    if mode.lower() not in MODES:
+        raise FaultSpecError(f"--fault '{text}': the fault is open, half or short, not '{mode}'")
+    return section, int(number), mode.lower()
+
+
+def zpw_sections(station: Station) -> list[str]:
+    return [s.id for s in station.model.sections if s.type.value == "zpw2000a" and s.carrier is not None]
+
+
+def collect_faults(station: Station, specs: Sequence[str]) -> dict[str, dict[int, str]]:
+    """Every --fault, checked against the station: section -> {capacitor number: mode}."""
+    from liansuo.circuits.zpw2000a import capacitor_positions
+
+    zpw = set(zpw_sections(station))
+    out: dict[str, dict[int, str]] = {}
+    for text in specs:
+        section, number, mode = parse_fault(text)
+        if section not in station.sections:
+            raise FaultSpecError(f"--fault '{text}': {station.id} has no section '{section}'")
+        if section not in zpw:
+            raise FaultSpecError(f"--fault '{text}': section {section} is not a ZPW-2000A section")
+        count = len(capacitor_positions(station, section))
+        if number > count:
+            have = f"capacitors 1-{count}" if count else "no compensation capacitors"
+            raise FaultSpecError(f"--fault '{text}': section {section} has {have}")
+        out.setdefault(section, {})[number] = mode
+    return out
+
+
+def section_rows(station: Station, faults: dict[str, dict[int, str]] | None = None) -> list[dict[str, Any]]:
+    """One row per ZPW-2000A section, in file order, with the fault applied where one is given."""
+    from liansuo.circuits.zpw2000a import ZpwFaults, fault_label, section_circuit
+
+    rows = []
+    for sid in zpw_sections(station):
+        circuit = section_circuit(station, sid)
+        case = (faults or {}).get(sid, {})
+        f = ZpwFaults(capacitors=dict(case))
+        adjustment = circuit.adjustment(f)
+        _, residual, cab = circuit.profile(f)
+        relay = "up" if adjustment.relay_up else ("marginal" if adjustment.relay_up_after(True) else "down")
+        row: dict[str, Any] = {
+            "id": sid, "carrier": circuit.carrier, "length_m": round(circuit.length_m, 1),
+            "capacitors": len(circuit.capacitors_m), "adjustment_mV": round(adjustment.voltage_mV, 1),
+            "max_shunt_residual_mV": round(float(residual.max()), 1),
+            "min_cab_current_mA": round(float(cab.min()), 1), "cab_min_mA": circuit.cab_min_mA, "relay": relay,
+            "fault": fault_label(case) if case else None,
+        }
+        if case:
+            _, residual0, cab0 = circuit.profile()
+            row["healthy"] = {"adjustment_mV": round(circuit.adjustment().voltage_mV, 1),
+                              "max_shunt_residual_mV": round(float(residual0.max()), 1),
+                              "min_cab_current_mA": round(float(cab0.min()), 1)}
+        rows.append(row)
+    return rows
+
+
+def _line(values: Sequence[object], widths: Sequence[int]) -> str:
+    return "".join(f"{v!s:>{w}}" if w else f"  {v}" for v, w in zip(values, widths, strict=True)).rstrip()
+
+
+def as_text(station: Station, rows: list[dict[str, Any]]) -> str:
+    from liansuo.circuits.zpw2000a import DEFAULT_PARAMS as P
+
+    if not rows:
+        return f"{station.id} has no ZPW-2000A sections"
+    widths = (9, 8, 9, 5, 10, 13, 11, 9, 0)
+    lines = [f"{station.display_name()}: ZPW-2000A sections ({P.standard_shunt_ohm:g} ohm shunt, ballast "
+             f"{P.ballast_ohm_km:g} ohm*km; relay pick-up {P.pickup_mV:g} mV, drop {P.drop_mV:g} mV)",
+             _line(("id", "carrier", "length_m", "caps", "adjust_mV", "max_resid_mV", "min_cab_mA", "relay", "fault"),
+                   widths)]
+    for r in rows:
+        low = "*" if r["min_cab_current_mA"] < r["cab_min_mA"] else ""
+        lines.append(_line((r["id"], r["carrier"], f"{r['length_m']:.1f}", r["capacitors"],
+                            f"{r['adjustment_mV']:.1f}", f"{r['max_shunt_residual_mV']:.1f}",
+                            f"{r['min_cab_current_mA']:.0f}{low}", r["relay"], r["fault"] or ""), widths))
+    if any(r["min_cab_current_mA"] < r["cab_min_mA"] for r in rows):
+        lines.append(f"* under the cab-signal minimum ({P.cab_min_mA[0]:g} mA; {P.cab_min_mA[3]:g} mA at 2600 Hz)")
+    if any(r["relay"] != "up" for r in rows):
+        lines.append(f"relay: marginal = under the {P.pickup_mV:g} mV pick-up (an up relay holds, a dropped one "
+                     "stays down); down = red band")
+    return "\n".join(lines)
+
+
+def write_csv(path: str, rows: list[dict[str, Any]]) -> None:
+    with open(path, "w", newline="", encoding="utf-8") as f:
+        writer = csv.DictWriter(f, fieldnames=COLUMNS, extrasaction="ignore")
+        writer.writeheader()
+        for r in rows:
+            writer.writerow({**r, "fault": r["fault"] or ""})
+
+
+def cmd_zpw(args: argparse.Namespace) -> int:
+    try:
+        station = load(args.station)
+    except StationError as exc:
+        for d in exc.diagnostics:
+            print(d, file=sys.stderr)
+        return 1
+    try:
+        faults = collect_faults(station, args.fault)
+    except FaultSpecError as exc:
+        print(f"liansuo zpw: {exc}", file=sys.stderr)
+        return 2
+    rows = section_rows(station, faults)
+    if args.csv:
+        try:
+            write_csv(args.csv, rows)
+        except OSError as exc:
+            print(f"liansuo zpw: cannot write {args.csv}: {exc.strerror}", file=sys.stderr)
+            return 2
+    if args.format == "json":
+        print(json.dumps({"station": station.id, "sections": rows}, ensure_ascii=False, indent=2))
+    else:
+        print(as_text(station, rows))
+    return 0
+
+
+def register(add: Callable[[str, Callable[[argparse.Namespace], int], str], argparse.ArgumentParser]) -> None:
+    """Add the ``zpw`` subcommand through the CLI's ``add(name, handler, help)``."""
+    sp = add("zpw", cmd_zpw, "ZPW-2000A section figures: adjustment, shunt residual, cab current (with faults)")
+    sp.add_argument("station", help="bundled station name or path")
+    sp.add_argument("--fault", action="append", default=[], metavar=FAULT_FORM,
+                    help="a compensation-capacitor fault (repeatable); capacitors are numbered from the lower end")
+    sp.add_argument("--format", choices=("text", "json"), default="text")
+    sp.add_argument("--csv", metavar="FILE", help="also write the table as CSV to FILE")

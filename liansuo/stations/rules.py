@@ -1,0 +1,189 @@
+"""Station-design rules (joint stagger, dead-zone spacing, fouling clearance, coding length, carriers) as warnings.
+
+The numbers come from ``design_rules.yaml``; each warning states the measured figure and the limit.
+"""
+
+from __future__ import annotations
+
+from functools import cache
+from importlib.resources import files
+from itertools import pairwise
+
+import yaml
+from pydantic import BaseModel, ConfigDict
+
+from .schema import CircuitType, Direction, JointKind, SignalKind
+from .source import Diagnostic, Loc
+from .station import Station
+
+
+class DesignRules(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+    joint_stagger_max_m: float
+    joint_stagger_max_turnout_m: float
+    dead_zone_spacing_min_m: float
+    dead_zone_spacing_relaxed_m: float
+    dead_zone_short_m: float
+    fouling_clearance_m: float
+    fouling_clearance_emu_m: float
+    cab_code_min_time_s: float
+    cab_code_margin_m: float
+    coding_speed_kmh: float
+    tuning_area_m: float
+    tuning_area_tolerance_m: float
+    tuning_dead_zone_max_m: float
+    capacitor_min_section_m: float
+    capacitor_spacing_m: float
+    phase25hz_max_length_m: float
+    bogie_wheelbase_min_m: float
+
+
+@cache
+def design_rules() -> DesignRules:
+    data = yaml.safe_load((files("liansuo.stations") / "design_rules.yaml").read_text(encoding="utf-8"))
+    return DesignRules.model_validate(data)
+
+
+def min_coded_length(speed_kmh: float, rules: DesignRules | None = None) -> float:
+    """L >= t * v + margin: the shortest section on which the cab signal can read a code (51.25 m at 45 km/h)."""
+    r = rules or design_rules()
+    return r.cab_code_min_time_s * speed_kmh / 3.6 + r.cab_code_margin_m
+
+
+def _index(items: list[object], ident: str) -> int:
+    return next(i for i, x in enumerate(items) if getattr(x, "id", None) == ident)
+
+
+class _Warner:
+    def __init__(self, station: Station) -> None:
+        self.st = station
+        self.r = design_rules()
+        self.out: list[Diagnostic] = []
+
+    def warn(self, loc: Loc, message: str, hint: str = "") -> None:
+        src = self.st.source
+        if src is None:
+            self.out.append(Diagnostic("<station>", 1, 1, message, hint, "warning"))
+        else:
+            self.out.append(src.diagnostic(loc, message, hint, severity="warning"))
+
+    def loc(self, key: str, ident: str, field: str | None = None) -> Loc:
+        i = _index(getattr(self.st.model, key), ident)
+        return (key, i, field) if field else (key, i)
+
+    def run(self) -> list[Diagnostic]:
+        self.stagger()
+        self.spacing()
+        self.fouling()
+        self.coding()
+        self.carriers()
+        self.lengths()
+        return self.out
+
+    def _at_turnout_section(self, joint: str) -> bool:
+        return any(s in self.st.turnout_section.values() for s in self.st.joint_sections(joint))
+
+    def stagger(self) -> None:
+        for dz in self.st.dead_zones:
+            j = self.st.joints[dz.joint]
+            if j.kind is JointKind.electrical:
+                if dz.length > self.r.tuning_dead_zone_max_m:
+                    self.warn(self.loc("joints", j.id), f"dead zone of {dz.length:.2f} m in tuning area '{j.id}' "
+                              f"exceeds {self.r.tuning_dead_zone_max_m:g} m", "check the tuning-unit positions")
+                continue
+            limit = self.r.joint_stagger_max_turnout_m if self._at_turnout_section(j.id) else self.r.joint_stagger_max_m
+            if dz.length > limit:
+                self.warn(self.loc("joints", j.id, "at2"),
+                          f"joint '{j.id}': rail joints staggered {dz.length:.2f} m (limit {limit:g} m); the dead zone "
+                          "can hide a wheelset", "move one rail's joint to bring the stagger within the limit")
+            if dz.length >= self.r.bogie_wheelbase_min_m:
+                self.warn(self.loc("joints", j.id, "at2"),
+                          f"joint '{j.id}': the {dz.length:.2f} m dead zone can hold a whole bogie (wheelbase from "
+                          f"{self.r.bogie_wheelbase_min_m:g} m): its wheelsets there shunt nothing, so a vehicle can "
+                          "vanish from the interlocking", "shorten the dead zone below the shortest bogie wheelbase")
+
+    def spacing(self) -> None:
+        zones = {dz.joint: dz for dz in self.st.dead_zones}
+        for sec, tracks in self.st.section_tracks.items():
+            bounding = set()
+            for t in tracks:
+                for p in self.st.track_ports[t]:
+                    if p.node in zones:
+                        bounding.add(p.node)
+            ordered = sorted(bounding, key=lambda j: self.st.joints[j].at)
+            for a, b in pairwise(ordered):
+                za, zb = zones[a], zones[b]
+                gap = zb.start - za.end
+                if gap <= 0 or gap >= self.r.dead_zone_spacing_min_m:
+                    continue
+                if (gap >= self.r.dead_zone_spacing_relaxed_m and za.length < self.r.dead_zone_short_m
+                        and zb.length < self.r.dead_zone_short_m):
+                    continue
+                self.warn(self.loc("joints", b, "at"),
+                          f"section '{sec}': dead zones at joints '{a}' and '{b}' are only {gap:.1f} m apart "
+                          f"(need >= {self.r.dead_zone_spacing_min_m:g} m, or >= "
+                          f"{self.r.dead_zone_spacing_relaxed_m:g} m when both are under "
+                          f"{self.r.dead_zone_short_m:g} m)",
+                          "a short vehicle could stand in both dead zones at once and vanish from the interlocking")
+
+    def fouling(self) -> None:
+        clearance = self.r.fouling_clearance_emu_m if self.st.model.emu else self.r.fouling_clearance_m
+        for sig in self.st.model.signals:
+            if sig.kind is not SignalKind.starting or sig.at not in self.st.joints:
+                continue
+            j = self.st.joints[sig.at]
+            ahead = 1.0 if sig.direction is Direction.down else -1.0
+            for fp in self.st.model.fouling_points:
+                d = (fp.at - j.at) * ahead
+                if -50.0 < d < clearance and abs(d) < 50.0:
+                    self.warn(self.loc("fouling_points", fp.id, "at"),
+                              f"fouling point {fp.id} is {d:.1f} m ahead of the joint of starting signal {sig.id} "
+                              f"(need >= {clearance:g} m)"
+                              + (" : the joint is inside the fouling limit" if d < 0 else ""),
+                              "a train stopped at the signal could foul the throat; move the joint or the signal back")
+
+    def coding(self) -> None:
+        for s in self.st.model.sections:
+            if not s.coded:
+                continue
+            v = s.speed_kmh or self.r.coding_speed_kmh
+            need = min_coded_length(v, self.r)
+            have = self.st.section_length(s.id)
+            if have < need:
+                self.warn(self.loc("sections", s.id), f"coded section '{s.id}' is {have:.1f} m long; at {v:g} km/h "
+                          f"the cab signal needs >= {need:.2f} m ({self.r.cab_code_min_time_s:g} s * v + "
+                          f"{self.r.cab_code_margin_m:g} m)", "lengthen the section or lower its speed")
+
+    def carriers(self) -> None:
+        for j in self.st.model.joints:
+            a, b = self.st.joint_sections(j.id)
+            sa, sb = self.st.sections[a], self.st.sections[b]
+            if (sa.type is CircuitType.zpw2000a and sb.type is CircuitType.zpw2000a and sa.carrier and sb.carrier
+                    and sa.carrier.split("-")[0] == sb.carrier.split("-")[0]):
+                self.warn(self.loc("joints", j.id), f"sections '{a}' and '{b}' on both sides of joint '{j.id}' "
+                          f"use the same carrier frequency ({sa.carrier}, {sb.carrier})",
+                          "alternate carriers along a line: 1700/2300 on the down line, 2000/2600 on the up line")
+            if j.kind is JointKind.electrical:
+                ta = j.tuning_area_m or self.r.tuning_area_m
+                if abs(ta - self.r.tuning_area_m) > self.r.tuning_area_tolerance_m:
+                    self.warn(self.loc("joints", j.id, "tuning_area_m"), f"tuning area of joint '{j.id}' is {ta:g} m "
+                              f"(standard {self.r.tuning_area_m:g} m, tolerance {self.r.tuning_area_tolerance_m:g} m)",
+                              "check the positions of the two tuning units")
+
+    def lengths(self) -> None:
+        for s in self.st.model.sections:
+            length = self.st.section_length(s.id)
+            if s.type is CircuitType.phase25hz and length > self.r.phase25hz_max_length_m:
+                self.warn(self.loc("sections", s.id), f"25 Hz section '{s.id}' is {length:.0f} m long "
+                          f"(limit about {self.r.phase25hz_max_length_m:g} m)", "split it with an insulated joint")
+            run = self.st.section_span(s.id)  # the track circuit's main run, not its branches added to it
+            if (s.type is CircuitType.zpw2000a and run > self.r.capacitor_min_section_m
+                    and (s.capacitors is None or s.capacitors.count == 0)):
+                self.warn(self.loc("sections", s.id), f"ZPW-2000A section '{s.id}' is {run:.0f} m long but has no "
+                          f"compensation capacitors (needed over {self.r.capacitor_min_section_m:g} m)",
+                          "add 'capacitors: {rule: standard}'")
+
+
+def design_warnings(station: Station) -> list[Diagnostic]:
+    return _Warner(station).run()

@@ -1,0 +1,425 @@
+"""The operator console (操作表示机): a Textual app over one :class:`~simulation.sim.Simulation`.
+
+The console is a thin view: everything it changes goes through the command language (``sim.command``), and it
+reads the simulation only to draw it. It paces ``sim.step()`` against the wall clock (1x real time by default);
+the layers below never read the wall clock. A recorder may be attached to write the session to a file, and the same
+app plays a recording back (:mod:`tui.replay`).
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from pathlib import Path
+from typing import ClassVar
+
+from rich.text import Text
+from textual.app import App, ComposeResult
+from textual.binding import Binding, BindingType
+from textual.containers import Horizontal, Vertical
+from textual.widgets import Footer
+
+from liansuo.simulation import Result
+from liansuo.simulation.exercise import Exercise, GoalCheck, bundled_exercises, check_goal, parse_exercise
+from liansuo.simulation.recording import FileRecorder
+from liansuo.simulation.sim import Simulation
+from liansuo.stations.source import StationError
+
+from .diagram import Diagram
+from .dialogs import ConfirmScreen, HelpScreen, MenuScreen, PasswordScreen
+from .instructor import InstructorPanel
+from .layout import Ref
+from .operate import MODES, Operator, Outcome
+from .panels import (
+    AlarmPanel,
+    CommandBar,
+    EventLog,
+    EventReader,
+    FunctionBar,
+    MessageLine,
+    StatusBar,
+    clock_text,
+    read_alarms,
+)
+
+SPEEDS = (0.25, 0.5, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0, 64.0)
+TICK_S = 0.125  # redraw at 8 Hz: often enough for the USU flash (35 per minute)
+MAX_STEPS_PER_TICK = 400
+PASSWORD_ENV = "LIANSUO_INSTRUCTOR_PASSWORD"
+
+
+class ConsoleApp(App[None]):
+    TITLE = "liansuo 联锁"
+    CSS = """
+    Screen { layout: vertical; background: #0c0f12; }
+    #main { height: 1fr; }
+    #left { width: 1fr; }
+    Diagram { height: 3fr; }
+    #panels { height: 1fr; min-height: 4; }
+    AlarmPanel { width: 2fr; }
+    EventLog { width: 3fr; }
+    """
+
+    BINDINGS: ClassVar[list[BindingType]] = [
+        Binding("colon", "command_bar", "command", key_display=":"),
+        Binding("space", "pause", "pause/run", key_display="space"),
+        Binding("full_stop", "step", "step", show=False),
+        Binding("greater_than_sign", "speed(1)", "faster", show=False),
+        Binding("less_than_sign", "speed(-1)", "slower", show=False),
+        Binding("escape", "escape", "drop", show=False),
+        Binding("a", "acknowledge", "ack alarms", show=False),
+        Binding("f1,question_mark", "help", "help", key_display="?"),
+        Binding("f2", "instructor", "instructor", key_display="F2"),
+        *[Binding(m.key, f"arm('{m.name}')", m.en, show=False) for m in MODES.values()],
+    ]
+
+    def __init__(self, station: str = "jiaopei", *, paused: bool = False, speed: float = 1.0,
+                 instructor_password: str | None = None, record: str | Path | None = None,
+                 exercise: str | Path | None = None, cycle_s: float = 0.25, sim: Simulation | None = None) -> None:
+        super().__init__()
+        self.station_ref = station
+        self.sim = sim if sim is not None else Simulation(station, cycle_s=cycle_s)
+        self.operator = Operator(self.sim)
+        self.paused = paused
+        self.speed = speed
+        self.password = instructor_password if instructor_password is not None else os.environ.get(PASSWORD_ENV)
+        self.instructor = False
+        self.acknowledged: set[str] = set()
+        self.events = EventReader()
+        self.exercise: Exercise | None = None
+        self.goal: GoalCheck | None = None
+        self.goal_reached_at: float | None = None
+        self._exercise_arg = exercise
+        self._debt = 0.0
+        self._wall = time.monotonic()
+        self._ticks = 0
+        self.warm_up = True
+        self._status = Text()
+        self.instructor_panel: InstructorPanel | None = None  # mounted the first time instructor mode opens
+        self.recorder: FileRecorder | None = None
+        if record is not None:
+            self.recorder = FileRecorder(self.sim, record, station=station)
+            self.recorder.attach()
+
+    # ---- layout ----
+    def compose(self) -> ComposeResult:
+        yield StatusBar(id="status")
+        with Horizontal(id="main"), Vertical(id="left"):
+            yield Diagram(lambda: self.sim, self.operator.pressed, id="diagram")
+            with Horizontal(id="panels"):
+                yield AlarmPanel(id="alarms")
+                yield EventLog(id="events")
+        yield FunctionBar(id="functions")
+        yield MessageLine(id="message")
+        yield CommandBar(lambda: self.sim, id="command")
+        yield Footer()
+
+    def _exercise_files(self) -> list[Path]:
+        files = bundled_exercises()
+        if self._exercise_arg is not None and Path(self._exercise_arg) not in files:
+            files.append(Path(self._exercise_arg))
+        return files
+
+    def on_mount(self) -> None:
+        # the main screen's widgets, kept so the clock and the answers reach them while a dialog is open
+        self.diagram = self.query_one(Diagram)
+        self.log_panel = self.query_one(EventLog)
+        self.alarm_panel = self.query_one(AlarmPanel)
+        self.function_bar = self.query_one(FunctionBar)
+        self.status_bar = self.query_one(StatusBar)
+        self.message_line = self.query_one(MessageLine)
+        self.command_bar = self.query_one(CommandBar)
+        self.diagram.focus()
+        if self.warm_up and self.sim.t == 0:
+            self.advance(1)  # one cycle, so the field has lit the lamps the interlocking commanded at start
+        self.say(f"{self.sim.station.display_name()}: click a signal's L or D button to start a route; ? for help")
+        if self._exercise_arg is not None:
+            self.load_exercise(str(self._exercise_arg))
+        self.refresh_views()
+        self.set_interval(TICK_S, self.tick)
+        self.started()
+
+    def started(self) -> None:
+        """After mounting (Textual calls every class's on_mount, so subclasses extend this instead)."""
+
+    def on_unmount(self) -> None:
+        if self.recorder is not None:
+            self.recorder.close()
+
+    # ---- the clock ----
+    def tick(self) -> None:
+        now = time.monotonic()
+        elapsed, self._wall = min(now - self._wall, 1.0), now
+        self._ticks += 1
+        try:
+            if not self.paused:
+                self._debt += elapsed * self.speed
+                n = min(int(self._debt / self.sim.cycle_s), MAX_STEPS_PER_TICK)
+                self._debt = min(self._debt - n * self.sim.cycle_s, self.sim.cycle_s * MAX_STEPS_PER_TICK)
+                self.advance(n)
+            self.refresh_views()
+        except Exception as exc:  # no traceback on the screen: stop the clock and say what happened
+            self.paused = True
+            self.say(f"internal error, clock paused: {type(exc).__name__}: {exc}", False)
+
+    def advance(self, cycles: int) -> None:
+        for _ in range(cycles):
+            self.sim.step()
+
+    def refresh_views(self) -> None:
+        sim = self.sim
+        self.diagram.update_view()
+        log = self.log_panel
+        for t, kind, text in self.events.new(sim):
+            log.add(f"{t:9.2f} {kind:8} {text}", "#ff6060" if kind == "alarm" else "")
+        alarms = read_alarms(sim, self.acknowledged)
+        self.alarm_panel.show(alarms, int(sim.t * 2) % 2 == 0)
+        if self.exercise is not None and self._ticks % 8 == 0:
+            self.check_exercise()
+        if self.instructor and self.instructor_panel is not None:
+            self.instructor_panel.show_faults(sim)
+        self.function_bar.set_armed(self.operator.mode.name if self.operator.mode else None)
+        status = self.status_text(alarms=sum(not a.acknowledged for a in alarms))
+        if status != self._status:
+            self._status = status
+            self.status_bar.update(status)
+
+    def status_text(self, alarms: int) -> Text:
+        sim = self.sim
+        out = Text(no_wrap=True, overflow="ellipsis")
+        out.append(f" {sim.station.model.name.zh} {sim.station.model.name.en} ", style="bold")
+        out.append(f"│ t {clock_text(sim.t)} ")
+        out.append("⏸ paused " if self.paused else "▶ ", style="bold #ffd700" if self.paused else "#80ff80")
+        out.append(f"{self.speed:g}x ")
+        if alarms:
+            out.append(f"│ ⚠ {alarms} alarm{'s' if alarms > 1 else ''} ", style="bold #ff4040")
+        counting = self.diagram.frame().countdown if self.diagram.layout_ is not None else {}
+        if counting:
+            out.append("│ 人解 " + " ".join(f"{s} {n}s" for s, n in sorted(counting.items())) + " ", style="#ffd700")
+        out.append("│ 教员 INSTRUCTOR " if self.instructor else "│ trainee ", style="#d0a0ff" if self.instructor
+                   else "")
+        if self.exercise is not None:
+            done = self.goal_reached_at is not None
+            out.append(f"│ {self.exercise.title}: {'goal reached' if done else 'in progress'} ",
+                       style="bold #40e070" if done else "#ffd700")
+        if self.recorder is not None:
+            out.append("│ ● REC ", style="#ff5050")
+        return out
+
+    # ---- commands ----
+    def send(self, line: str, source: str = "trainee") -> Result:
+        """Send one line of the command language; log it with its answer and show the answer."""
+        line = line.strip()
+        if not line:
+            return Result.accept("")
+        if self.recorder is not None:
+            self.recorder.source = source
+        try:
+            result = self.sim.command(line)
+        except Exception as exc:  # a command must never bring the console down
+            result = Result.refuse(f"internal error: {type(exc).__name__}: {exc}")
+        log = self.log_panel
+        who = {"trainee": "trainee>", "instructor": "instr.>", "exercise": "lesson>"}.get(source, f"{source}>")
+        log.add(f"{self.sim.t:9.2f} {who:8} {line}", "#9fd3ff" if source == "trainee" else "#d0a0ff")
+        if not result.ok:
+            log.add(f"{self.sim.t:9.2f} {'refused':8} {result.message}", "#ff8080")
+        if result.message or not result.ok:
+            self.say(result.message or "refused", result.ok)
+        self.refresh_views()
+        return result
+
+    def say(self, text: str, ok: bool | None = None) -> None:
+        self.message_line.say(text, ok)
+
+    def on_command_bar_hint(self, event: CommandBar.Hint) -> None:
+        self.say(event.text)
+
+    def on_input_submitted(self, event: CommandBar.Submitted) -> None:
+        if not isinstance(event.input, CommandBar):
+            return
+        bar = event.input
+        line = event.value.strip().lstrip(":").strip()
+        bar.remember(line)
+        bar.value = ""
+        if line:
+            self.submit_line(line)
+
+    def submit_line(self, line: str) -> None:
+        self.send(line, "instructor" if self.instructor else "trainee")
+
+    # ---- operating by buttons ----
+    def on_diagram_pressed(self, event: Diagram.Pressed) -> None:
+        try:
+            self.press(event.ref)
+        except Exception as exc:
+            self.say(f"internal error: {type(exc).__name__}: {exc}", False)
+
+    def press(self, ref: Ref) -> None:
+        panel = self.instructor_panel
+        if self.instructor and panel is not None and panel.picking:
+            self.say(panel.pick(ref))
+            return
+        self.carry_out(self.operator.press(ref))
+
+    def carry_out(self, out: Outcome) -> None:
+        if out.menu is not None:
+            kind, element = out.menu
+            self.push_screen(MenuScreen(kind, element, self._menu_title(kind, element)),
+                             lambda name: self._menu_chosen(kind, element, name))
+        elif out.command and out.confirm:
+            command = out.command
+
+            def answered(yes: bool | None) -> None:
+                if yes:
+                    self.send(command)
+                else:
+                    self.say(f"not sent: {command}")
+
+            self.push_screen(ConfirmScreen(out.confirm), answered)
+        elif out.command:
+            self.send(out.command)
+        elif out.message:
+            self.say(out.message)
+        self.function_bar.set_armed(self.operator.mode.name if self.operator.mode else None)
+        self.diagram.update_view()
+
+    def _menu_title(self, kind: str, element: str) -> str:
+        sim = self.sim
+        if kind == "turnout":
+            pos, locked = sim.turnout_state(element)
+            return f"道岔 turnout {element}: {pos or 'no indication'}{', locked' if locked else ''}"
+        if kind == "signal":
+            return f"信号机 signal {element}: {sim.aspect(element)}"
+        return f"区段 section {element}: {sim.section_state(element)}"
+
+    def _menu_chosen(self, kind: str, element: str, name: str | None) -> None:
+        if name:
+            self.carry_out(self.operator.apply(name, Ref(kind, element)))
+
+    def on_function_bar_selected(self, event: FunctionBar.Selected) -> None:
+        self.action_arm(event.mode)
+
+    # ---- actions ----
+    def action_arm(self, mode: str) -> None:
+        out = self.operator.arm(mode)
+        if out.command:  # a button that acts on the whole station
+            self.carry_out(out)
+            return
+        self.function_bar.set_armed(self.operator.mode.name if self.operator.mode else None)
+        self.say(out.message or "function dropped")
+        self.diagram.update_view()
+
+    def action_command_bar(self) -> None:
+        self.command_bar.focus()
+
+    def action_escape(self) -> None:
+        if self.command_bar.has_focus:
+            self.diagram.focus()
+            return
+        self.operator.reset()
+        self.say("selection dropped")
+        self.refresh_views()
+
+    def action_pause(self) -> None:
+        self.paused = not self.paused
+        self._wall = time.monotonic()
+        self._debt = 0.0
+        self.refresh_views()
+
+    def action_step(self) -> None:
+        self.paused = True
+        self.advance(1)
+        self.refresh_views()
+
+    def action_speed(self, step: int) -> None:
+        i = min(range(len(SPEEDS)), key=lambda k: abs(SPEEDS[k] - self.speed))
+        self.speed = SPEEDS[max(0, min(len(SPEEDS) - 1, i + step))]
+        self.refresh_views()
+
+    def action_acknowledge(self) -> None:
+        self.acknowledged |= {a.key for a in read_alarms(self.sim, set())}
+        self.refresh_views()
+
+    def on_alarm_panel_acknowledge(self, event: AlarmPanel.Acknowledge) -> None:
+        if event.key:
+            self.acknowledged.add(event.key)
+        self.refresh_views()
+
+    def action_help(self) -> None:
+        self.push_screen(HelpScreen())
+
+    async def action_instructor(self) -> None:
+        if self.instructor:
+            await self.set_instructor(False)
+        elif self.password:
+            self.push_screen(PasswordScreen(), self._password_given)
+        else:
+            await self.set_instructor(True)
+
+    async def _password_given(self, given: str | None) -> None:
+        if given == self.password:
+            await self.set_instructor(True)
+        elif given:
+            self.say("wrong instructor password", False)
+        else:
+            self.say("instructor mode not opened")
+
+    async def set_instructor(self, on: bool) -> None:
+        if on and self.instructor_panel is None:
+            self.instructor_panel = InstructorPanel(lambda: self.sim, self._exercise_files(), id="instructor")
+            await self.screen_stack[0].query_one("#main").mount(self.instructor_panel)
+            if self.recorder is not None:
+                self.instructor_panel.show_recording(f"recording to {self.recorder.path}")
+            self._show_goal()
+        self.instructor = on
+        if self.instructor_panel is not None:
+            self.instructor_panel.set_class(on, "-shown")
+        self.say("instructor mode: faults, trains and exercises in the panel on the right (F2 closes it)" if on
+                 else "trainee mode")
+        self.refresh_views()
+
+    # ---- instructor panel ----
+    def on_instructor_panel_send(self, event: InstructorPanel.Send) -> None:
+        self.send(event.line, "instructor")
+
+    def on_instructor_panel_load_exercise(self, event: InstructorPanel.LoadExercise) -> None:
+        self.load_exercise(event.path)
+
+    def load_exercise(self, path: str) -> None:
+        try:
+            ex = parse_exercise(path)
+        except StationError as exc:
+            self.say(f"exercise not loaded: {exc.diagnostics[0] if exc.diagnostics else exc}", False)
+            return
+        except OSError as exc:
+            self.say(f"exercise not loaded: {exc}", False)
+            return
+        if ex.station_ref() not in (self.station_ref, self.sim.station.id):
+            self.say(f"exercise '{ex.title}' is for station {ex.station}; start the console with "
+                     f"'liansuo tui {ex.station} --exercise {path}'", False)
+            return
+        self.exercise = ex
+        self.goal_reached_at = None
+        self.log_panel.add(f"{self.sim.t:9.2f} {'lesson':8} {ex.title}: {ex.description}", "#d0a0ff")
+        for line in ex.setup:
+            self.send(line, "exercise")
+        self.say(f"exercise: {ex.title}. Goal: {ex.goal}")
+        self.check_exercise()
+
+    def check_exercise(self) -> None:
+        ex = self.exercise
+        if ex is None:
+            return
+        self.goal = check_goal(self.sim, ex)
+        if self.goal.reached and self.goal_reached_at is None:
+            self.goal_reached_at = self.sim.t
+            self.log_panel.add(f"{self.sim.t:9.2f} {'lesson':8} goal reached: {ex.goal}", "bold #40e070")
+            self.say(f"goal reached: {ex.goal}", True)
+        self._show_goal()
+
+    def _show_goal(self) -> None:
+        ex, goal = self.exercise, self.goal
+        if ex is None or goal is None or self.instructor_panel is None:
+            return
+        lines = "\n".join(f"{'✓' if ok else '·'} {line.removeprefix('expect ')}" for line, ok, _ in goal.lines)
+        self.instructor_panel.show_goal(f"{ex.title}\n{ex.goal}\n{lines}")

@@ -1,0 +1,534 @@
+"""The schematic layout of the station diagram (站场图): where every cell of the drawing goes.
+
+Tracks are horizontal bands on their schematic row (``row`` in the station file; inferred from the topology where a
+track has none), turnout legs leave their turnout diagonally (╱ ╲), and every node (end, joint, turnout) gets a
+column. Columns keep the order of positions along the line but not their scale: a throat is spread out and an open
+line squeezed, and they are pushed apart just enough for every label (signals with their lamps and buttons, turnout
+numbers) to fit on its line. A node's ``draw: {x, y}`` in the station file gives its row (``y``) and a minimum column
+(``x``).
+
+The layout is static: it says which cell shows which element (:class:`Ref`). The diagram widget colours the cells
+from the simulation's state at every redraw.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+
+from liansuo.stations.schema import Direction, SectionRole
+from liansuo.stations.station import Station
+
+BAND = "━"
+DIAG_DOWN = "╲"  # going right and down the screen
+DIAG_UP = "╱"
+CROSS = "╳"
+JOINT = "┃"
+DEAD_JOINT = "╏"
+FOULING = "┿"
+LAMP = "●"
+
+ROLE_PRIORITY = {"diag": 0, "band": 0, "node": 1, "fp": 1, "joint": 2, "end": 2, "label": 3, "door": 4, "plabel": 4,
+                 "tlabel": 5, "tmark": 5, "signame": 5, "lamp": 6, "button": 6}
+
+
+@dataclass(frozen=True)
+class Ref:
+    """What a cell shows: ``kind`` is section, turnout, signal, button, joint, end, platform or fouling."""
+
+    kind: str
+    id: str
+    sub: str = ""  # button kind (train, shunt, end, exit, variant); door key for platforms
+
+
+@dataclass
+class Glyph:
+    ch: str
+    role: str  # band, diag, node, joint, end, fp, label, tlabel, tmark, lamp, signame, button, door, plabel
+    ref: Ref | None
+    section: str = ""  # the section whose band colour this cell takes (band, diag, node, fp, label)
+    leg: tuple[str, str] | None = None  # (turnout, leg) for the cell next to a turnout on that leg
+    slot: int = 0  # lamp slot of a signal; door index of a platform
+    also: str = ""  # a second section drawn over the same cell (a crossing)
+
+
+@dataclass
+class Item:
+    """A label of fixed shape anchored at a position's column: cells (dx, ch, role, ref, slot) on one line."""
+
+    line: int
+    pos: int  # index into the sorted positions
+    cells: list[tuple[int, str, str, Ref | None, int]]
+    priority: int = 1
+
+    @property
+    def lo(self) -> int:
+        return min(c[0] for c in self.cells)
+
+    @property
+    def hi(self) -> int:
+        return max(c[0] for c in self.cells)
+
+
+@dataclass
+class Layout:
+    width: int
+    height: int
+    grid: list[list[Glyph | None]]
+    targets: dict[Ref, tuple[int, int]] = field(default_factory=dict)  # first cell of every clickable element
+    lamp_slots: dict[str, list[tuple[int, int]]] = field(default_factory=dict)
+    # signal -> places for its release countdown, best first: (x, y, step) where the text starts and grows by step
+    countdown_at: dict[str, list[tuple[int, int, int]]] = field(default_factory=dict)
+    section_cells: dict[str, list[tuple[int, int]]] = field(default_factory=dict)
+    lpr: int = 3
+    zoom: int = 1
+
+    def at(self, x: int, y: int) -> Glyph | None:
+        if 0 <= y < self.height and 0 <= x < self.width:
+            return self.grid[y][x]
+        return None
+
+    def text(self) -> str:
+        """The drawing as plain text (for tests and for a quick look)."""
+        return "\n".join("".join(g.ch if g else " " for g in row).rstrip() for row in self.grid)
+
+
+# ---- rows ----------------------------------------------------------------------------------------------------------
+def track_rows(station: Station) -> dict[str, float]:
+    """Every track's schematic row: the file's ``row``, or inferred from its neighbours (reverse legs one row off)."""
+    rows: dict[str, float] = {t.id: t.row for t in station.model.tracks if t.row is not None}
+    if not rows and station.model.tracks:
+        longest = max(station.model.tracks, key=lambda t: station.track_length(t.id))
+        rows[longest.id] = 0.0
+    ports = station.track_ports
+    changed = True
+    while changed:
+        changed = False
+        for tid in ports:
+            if tid in rows:
+                continue
+            guess = _guess_row(station, tid, rows)
+            if guess is not None:
+                rows[tid] = guess
+                changed = True
+        if not changed:
+            missing = [t for t in ports if t not in rows]
+            if missing:
+                rows[missing[0]] = 0.0
+                changed = True
+    return rows
+
+
+def _guess_row(station: Station, tid: str, rows: dict[str, float]) -> float | None:
+    for port in station.track_ports[tid]:
+        others = [(leg, t) for leg, t in station.node_tracks.get(port.node, []) if t != tid]
+        if port.leg is None:
+            known = [rows[t] for _, t in others if t in rows]
+            if known:
+                return known[0]
+            continue
+        by_leg = {leg: t for leg, t in others}
+        if port.leg == "reverse":
+            trunk = by_leg.get("point") or by_leg.get("normal")
+            if trunk in rows:
+                return rows[trunk] + 1.0
+        else:
+            twin = by_leg.get("normal" if port.leg == "point" else "point")
+            if twin in rows:
+                return rows[twin]
+            rev = by_leg.get("reverse")
+            if rev in rows:
+                return rows[rev] - 1.0
+    return None
+
+
+def node_rows(station: Station, rows: dict[str, float]) -> dict[str, float]:
+    """A node sits on the row of its trunk: a turnout on its point track, a joint on its plain (non-leg) track."""
+    out: dict[str, float] = {}
+    for node, attached in station.node_tracks.items():
+        draw = _draw(station, node)
+        if draw is not None:
+            out[node] = draw[1]
+            continue
+        if node in station.turnouts:
+            legs = {leg: t for leg, t in attached}
+            trunk = legs.get("point") or legs.get("normal") or attached[0][1]
+            out[node] = rows[trunk]
+            continue
+        plain = [rows[t] for _, t in attached if not _other_end_is_leg(station, t, node)]
+        vals = plain or [rows[t] for _, t in attached]
+        out[node] = sum(vals) / len(vals)
+    return out
+
+
+def _other_end_is_leg(station: Station, track: str, node: str) -> bool:
+    a, b = station.track_ports[track]
+    other = b if a.node == node else a
+    return other.leg is not None
+
+
+def _draw(station: Station, node: str) -> tuple[float, float] | None:
+    obj = station.ends.get(node) or station.joints.get(node) or station.turnouts.get(node)
+    d = getattr(obj, "draw", None)
+    return (d.x, d.y) if d is not None else None
+
+
+# ---- the builder ----------------------------------------------------------------------------------------------------
+ZOOM_K = (0.18, 0.35, 0.6, 0.9, 1.3)  # columns per sqrt(metre) between neighbouring positions, by zoom level
+MAX_ZOOM = len(ZOOM_K) - 1
+
+
+class _Builder:
+    def __init__(self, station: Station, lamps_per_aspect: dict[str, list[str]], lpr: int, zoom: int) -> None:
+        self.st = station
+        self.lamps_per_aspect = lamps_per_aspect
+        self.lpr = lpr
+        self.zoom = max(0, min(MAX_ZOOM, zoom))
+        self.rows = track_rows(station)
+        self.nrows = node_rows(station, self.rows)
+        all_rows = list(self.rows.values()) + list(self.nrows.values())
+        self.rmin = min(all_rows) if all_rows else 0.0
+        self.top = 2
+        # positions along the line that get a column: nodes, fouling points, variant buttons
+        pos: set[float] = set()
+        for n in station.node_tracks:
+            pos.add(self._p(station.node_at(n)))
+        for fp in station.model.fouling_points:
+            pos.add(self._p(fp.at))
+        for b in station.model.buttons:
+            if b.kind == "variant" and b.at in station.tracks:
+                pos.add(self._p(self._track_mid(b.at)))
+        self.positions = sorted(pos)
+        self.index = {p: i for i, p in enumerate(self.positions)}
+        self.items: list[Item] = []
+        self.min_gap: list[int] = [0] * len(self.positions)  # col[i] - col[i-1] >= this
+        self.pairs: list[tuple[int, int, int]] = []  # (i, j, k): col[j] - col[i] >= k
+        self.lower: list[int] = [0] * len(self.positions)
+
+    @staticmethod
+    def _p(x: float) -> float:
+        return round(x, 2)
+
+    def _track_mid(self, track: str) -> float:
+        lo, hi = self.st.track_span(track)
+        return (lo + hi) / 2
+
+    def pos_of(self, node: str) -> int:
+        return self.index[self._p(self.st.node_at(node))]
+
+    def line(self, row: float) -> int:
+        return math.floor((row - self.rmin) * self.lpr + 0.5) + self.top
+
+    # ---- gathering constraints ----
+    def plan(self) -> None:
+        k = ZOOM_K[self.zoom]
+        for i in range(1, len(self.positions)):
+            d = self.positions[i] - self.positions[i - 1]
+            self.min_gap[i] = max(1, min(14, round(k * math.sqrt(d))))
+        station_track = 10 + 6 * self.zoom
+        for tid, (a, b) in self.st.track_ports.items():
+            pa, pb = self.pos_of(a.node), self.pos_of(b.node)
+            (pa, a), (pb, b) = sorted([(pa, a), (pb, b)], key=lambda x: x[0])
+            yt = self.line(self.rows[tid])
+            da = abs(self.line(self.nrows[a.node]) - yt)
+            db = abs(self.line(self.nrows[b.node]) - yt)
+            need = da + db + 2
+            if self.st.sections[self.st.tracks[tid].section].role is SectionRole.station_track:
+                need = max(need, station_track)
+            if pa != pb:
+                self.pairs.append((pa, pb, need))
+            # diagonal cells are fixed relative to their node: labels must keep clear of them
+            ya, yb = self.line(self.nrows[a.node]), self.line(self.nrows[b.node])
+            for i in range(1, da + 1):
+                self.items.append(Item(ya + (i if yt > ya else -i), pa, [(i, "", "diag", None, 0)], 0))
+            for i in range(1, db + 1):
+                self.items.append(Item(yb + (i if yt > yb else -i), pb, [(-i, "", "diag", None, 0)], 0))
+        for node in self.st.node_tracks:
+            drawn = _draw(self.st, node)
+            if drawn is not None:
+                p = self.pos_of(node)
+                self.lower[p] = max(self.lower[p], int(drawn[0]))
+        self._signal_items()
+        self._turnout_items()
+        self._variant_items()
+
+    def lamp_slots(self, signal: str) -> int:
+        have = {lamp.value for lamp in self.st.signals[signal].lamps}
+        best = 1
+        for lamps in self.lamps_per_aspect.values():
+            if lamps and set(lamps) <= have:
+                best = max(best, len(lamps))
+        return best
+
+    def _signal_items(self) -> None:
+        """Signals stand beside their joint on the approach side: a down signal left of it on the line below, an up
+        signal right of it on the line above. Outwards from the joint: lamps, buttons (L train, D shunting), name."""
+        st = self.st
+        Token = list[tuple[str, str, Ref | None, int]]
+        by_side: dict[tuple[str, str], list[Token]] = {}
+        for sig in st.model.signals:
+            if sig.at not in st.node_tracks:
+                continue
+            ref = Ref("signal", sig.id)
+            n = self.lamp_slots(sig.id)
+            down = sig.direction is Direction.down
+            # lamp slot 0 is the one next to the joint; tokens are in reading order
+            tokens: list[Token] = [[(LAMP, "lamp", ref, n - 1 - i if down else i) for i in range(n)]]
+            buttons: Token = [("L" if b.value == "train" else "D", "button", Ref("button", sig.id, b.value), 0)
+                              for b in sig.buttons]
+            if buttons:
+                tokens.append(buttons)
+            tokens.append([(" ", "gap", None, 0)])
+            tokens.append([(ch, "signame", ref, 0) for ch in sig.id])
+            by_side.setdefault((sig.at, sig.direction.value), []).extend(tokens)
+        for b in st.model.buttons:
+            if b.kind == "variant" or b.at not in st.node_tracks:
+                continue
+            direction = b.direction.value if b.direction else self._free_side(b.at)
+            group = by_side.setdefault((b.at, direction), [])
+            if group:
+                group.append([(" ", "gap", None, 0)])
+            group.append([(ch, "button", Ref("button", b.id, b.kind), 0) for ch in b.id])
+        for (node, direction), tokens in by_side.items():
+            y = self.line(self.nrows[node])
+            down = direction == "down"
+            cells: list[tuple[int, str, str, Ref | None, int]] = []
+            edge = 0  # the next free cell outwards from the joint
+            for token in tokens:
+                n = len(token)
+                first = edge - n + 1 if down else edge
+                for i, (ch, role, tref, slot) in enumerate(token):
+                    if role != "gap":
+                        cells.append((first + i, ch, role, tref, slot))
+                edge = first - 1 if down else first + n
+            self.items.append(Item(y + 1 if down else y - 1, self.pos_of(node), cells, 2))
+
+    def _free_side(self, node: str) -> str:
+        """For a button at an end: the side of the line away from its track, i.e. where the line leads."""
+        (_, track), *_ = self.st.node_tracks[node]
+        lo, _hi = self.st.track_span(track)
+        return "up" if self._p(lo) == self._p(self.st.node_at(node)) else "down"
+
+    def _turnout_items(self) -> None:
+        st = self.st
+        for t in st.model.turnouts:
+            y = self.line(self.nrows[t.id])
+            rev = st.leg_track(t.id, "reverse")
+            ry = self.line(self.rows[rev])
+            a, b = st.track_ports[rev]
+            other = b if a.node == t.id else a
+            if ry == y:
+                ry = self.line(self.nrows[other.node])
+            line = y - 1 if ry > y else y + 1
+            legs_right = st.node_at(other.node) > st.node_at(t.id)
+            text = t.id
+            n = len(text) + 1  # the number and one cell for the lock mark
+            ref = Ref("turnout", t.id)
+            cells: list[tuple[int, str, str, Ref | None, int]] = []
+            for i in range(n):
+                dx = i if legs_right else i - n + 1
+                ch, role = (text[i], "tlabel") if i < len(text) else (" ", "tmark")
+                cells.append((dx, ch, role, ref, 0))
+            self.items.append(Item(line, self.pos_of(t.id), cells, 2))
+
+    def _variant_items(self) -> None:
+        for b in self.st.model.buttons:
+            if b.kind != "variant" or b.at not in self.st.tracks:
+                continue
+            y = self.line(self.rows[b.at])
+            bands = {self.line(r) for r in self.rows.values()}
+            y = next((c for c in (y + 1, y - 1) if c not in bands), y)
+            p = self.index[self._p(self._track_mid(b.at))]
+            ref: Ref | None = Ref("button", b.id, "variant")
+            cells = [(i - len(b.id) // 2, ch, "button", ref, 0) for i, ch in enumerate(b.id)]
+            self.items.append(Item(y, p, cells, 2))
+
+    # ---- solving: longest paths over a DAG of lower bounds ----
+    def columns(self) -> list[int]:
+        n = len(self.positions)
+        need: list[list[tuple[int, int]]] = [[] for _ in range(n)]  # j -> [(i, k)]
+        for i, j, k in self.pairs:
+            need[j].append((i, k))
+        by_line: dict[int, list[Item]] = {}
+        for it in self.items:
+            by_line.setdefault(it.line, []).append(it)
+        for items in by_line.values():
+            for a in items:
+                for b in items:
+                    if a.pos < b.pos:
+                        need[b.pos].append((a.pos, a.hi - b.lo + 2))
+        left = [0] * n
+        for it in self.items:
+            left[it.pos] = max(left[it.pos], -it.lo)
+        col = [0] * n
+        for j in range(n):
+            c = max(2 + left[j], self.lower[j])
+            if j:
+                c = max(c, col[j - 1] + self.min_gap[j])
+            for i, k in need[j]:
+                c = max(c, col[i] + k)
+            col[j] = c
+        return col
+
+
+def build_layout(station: Station, lamps_per_aspect: dict[str, list[str]], *, lpr: int = 3, zoom: int = 1,
+                 width: int = 0) -> Layout:
+    """Lay the station out; with ``width`` the columns are stretched to fill that many cells where they fit."""
+    b = _Builder(station, lamps_per_aspect, lpr, zoom)
+    b.plan()
+    col = b.columns()
+    right = max((col[it.pos] + it.hi for it in b.items), default=0)
+    natural = max(max(col, default=0), right) + 3
+    if width > natural:
+        factor = (width - 3) / (natural - 3)
+        col = [c + math.floor((factor - 1) * c) for c in col]
+    right = max((col[it.pos] + it.hi for it in b.items), default=0)
+    w = max(max(col, default=0), right) + 3
+    lines = [b.line(r) for r in list(b.rows.values()) + list(b.nrows.values())]
+    h = max(max(lines, default=0), max((it.line for it in b.items), default=0)) + 2
+    lay = Layout(w, h, [[None] * w for _ in range(h)], lpr=lpr, zoom=b.zoom)
+    _paint(b, col, lay)
+    return lay
+
+
+# ---- painting -------------------------------------------------------------------------------------------------------
+def _put(lay: Layout, x: int, y: int, g: Glyph) -> None:
+    if not (0 <= y < lay.height and 0 <= x < lay.width):
+        return
+    old = lay.grid[y][x]
+    if old is not None:
+        if old.role == "diag" and g.role == "diag" and old.ch != g.ch:
+            old.ch, old.also = CROSS, g.section
+            return
+        if old.role in ("band", "diag") and g.role in ("band", "diag"):
+            if old.section != g.section:
+                old.also = g.section
+            return
+        if ROLE_PRIORITY.get(old.role, 0) > ROLE_PRIORITY.get(g.role, 0):
+            return
+    lay.grid[y][x] = g
+    if g.ref is not None and g.ref not in lay.targets:
+        lay.targets[g.ref] = (x, y)
+
+
+def _paint(b: _Builder, col: list[int], lay: Layout) -> None:
+    st = b.st
+    cx = {n: col[b.pos_of(n)] for n in st.node_tracks}
+    cy = {n: b.line(b.nrows[n]) for n in st.node_tracks}
+    runs: dict[str, list[tuple[int, int, int]]] = {}  # section -> horizontal runs (y, x0, x1)
+    for tid, (pa, pb) in st.track_ports.items():
+        sec = st.tracks[tid].section
+        a, bb = (pa, pb) if cx[pa.node] <= cx[pb.node] else (pb, pa)
+        xa, xb, ya, yb = cx[a.node], cx[bb.node], cy[a.node], cy[bb.node]
+        yt = b.line(b.rows[tid])
+        da, db = abs(ya - yt), abs(yb - yt)
+        path: list[tuple[int, int, str]] = []
+        for i in range(1, da + 1):
+            path.append((xa + i, ya + (i if yt > ya else -i), DIAG_DOWN if yt > ya else DIAG_UP))
+        x0, x1 = xa + da + 1, xb - db - 1
+        path += [(x, yt, BAND) for x in range(x0, x1 + 1)]
+        for i in range(db, 0, -1):
+            path.append((xb - i, yb + (i if yt > yb else -i), DIAG_DOWN if yb > yt else DIAG_UP))
+        if x1 >= x0:
+            runs.setdefault(sec, []).append((yt, x0, x1))
+        for k, (x, y, ch) in enumerate(path):
+            leg = None
+            if k == 0 and a.leg in ("normal", "reverse"):
+                leg = (a.node, a.leg)
+            if k == len(path) - 1 and bb.leg in ("normal", "reverse"):
+                leg = (bb.node, bb.leg)
+            role = "band" if ch == BAND else "diag"
+            _put(lay, x, y, Glyph(ch, role, Ref("section", sec), sec, leg))
+            lay.section_cells.setdefault(sec, []).append((x, y))
+    _paint_nodes(b, lay, cx, cy)
+    for fp in st.model.fouling_points:
+        x, y = col[b.index[b._p(fp.at)]], b.line(b.rows[fp.track])
+        g = lay.at(x, y)
+        if g is not None and g.role == "band":
+            _put(lay, x, y, Glyph(FOULING, "fp", Ref("fouling", fp.id), g.section))
+    for sec, rs in runs.items():
+        y, x0, x1 = max(rs, key=lambda r: r[2] - r[1])
+        if x1 - x0 + 1 >= len(sec) + 4:
+            start = x0 + (x1 - x0 + 1 - len(sec)) // 2
+            for i, ch in enumerate(sec):
+                _put(lay, start + i, y, Glyph(ch, "label", Ref("section", sec), sec))
+    for it in sorted(b.items, key=lambda it: it.priority):
+        if it.priority == 0:
+            continue
+        for dx, ch, role, ref, slot in it.cells:
+            x = col[it.pos] + dx
+            _put(lay, x, it.line, Glyph(ch, role, ref, slot=slot))
+            if role == "lamp" and ref is not None:
+                lay.lamp_slots.setdefault(ref.id, []).append((x, it.line))
+        sig_refs = [c[3] for c in it.cells if c[2] == "lamp" and c[3] is not None]
+        if sig_refs:
+            step = 1 if it.cells[-1][0] > it.cells[0][0] else -1
+            outer = col[it.pos] + (it.hi + 2 if step > 0 else it.lo - 2)
+            # beyond the name on the same line, else on the next line out, under (over) the name
+            beside = (col[it.pos] + (it.hi if step > 0 else it.lo), it.line - step, -step)
+            for r in {r.id for r in sig_refs}:
+                lay.countdown_at[r] = [(outer, it.line, step), beside]
+    _paint_platforms(b, lay, cx, cy)
+
+
+def _paint_nodes(b: _Builder, lay: Layout, cx: dict[str, int], cy: dict[str, int]) -> None:
+    st = b.st
+    dead = {dz.joint for dz in st.dead_zones}
+    for n in st.node_tracks:
+        x, y = cx[n], cy[n]
+        if n in st.turnouts:
+            sec = st.turnout_section[n]
+            _put(lay, x, y, Glyph(BAND, "node", Ref("turnout", n), sec))
+        elif n in st.joints:
+            ch = DEAD_JOINT if n in dead else JOINT
+            _put(lay, x, y, Glyph(ch, "joint", Ref("joint", n)))
+        else:
+            (_, track), *_ = st.node_tracks[n]
+            lo, _hi = st.track_span(track)
+            at_left = b._p(lo) == b._p(st.node_at(n))
+            end = st.ends[n]
+            buffer = end.kind.value == "buffer"
+            ch = ("╟" if at_left else "╢") if buffer else ("«" if at_left else "»")
+            _put(lay, x, y, Glyph(ch, "end", Ref("end", n)))
+
+
+def _paint_platforms(b: _Builder, lay: Layout, cx: dict[str, int], cy: dict[str, int]) -> None:
+    st = b.st
+    for p in st.model.platforms:
+        tracks = st.section_tracks.get(p.section, [])
+        if not tracks:
+            continue
+        best = max(tracks, key=lambda t: abs(cx[st.track_ports[t][1].node] - cx[st.track_ports[t][0].node]))
+        a, bb = st.track_ports[best]
+        x0, x1 = sorted((cx[a.node], cx[bb.node]))
+        y = b.line(b.rows[best])
+        sides = p.screen_doors or []
+        for sd in sides:
+            # seen facing the down direction (towards the right): left is up the screen
+            line = y - 1 if sd.side.value == "left" else y + 1
+            free = [x for x in range(x0 + 2, x1 - 1) if lay.at(x, line) is None and lay.at(x - 1, line) is None
+                    and lay.at(x + 1, line) is None]
+            if len(free) < len(p.id) + 3:
+                continue
+            key = f"{p.id}:{sd.side.value}"
+            ref = Ref("platform", p.id, key)
+            span = _longest_run(free)
+            n_doors = min(len(span) - len(p.id) - 1, 12)
+            start = span[0] + (len(span) - (len(p.id) + 1 + n_doors)) // 2
+            for i, ch in enumerate(p.id):
+                _put(lay, start + i, line, Glyph(ch, "plabel", ref))
+            for i in range(n_doors):
+                _put(lay, start + len(p.id) + 1 + i, line, Glyph("▬", "door", ref, slot=i))
+
+
+def _longest_run(xs: Iterable[int]) -> list[int]:
+    best: list[int] = []
+    cur: list[int] = []
+    for x in xs:
+        if cur and x != cur[-1] + 1:
+            cur = []
+        cur.append(x)
+        if len(cur) > len(best):
+            best = list(cur)
+    return best
