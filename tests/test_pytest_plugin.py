@@ -31,7 +31,7 @@ tests:
 
 def test_scripts_are_collected_and_failures_show_step_expectation_and_state(pytester: pytest.Pytester) -> None:
     pytester.makefile(".yaml", test_routes=SCRIPT)
-    station = (ROOT / "liansuo/stations/library/jiaopei.yaml").read_text("utf-8")
+    station = (ROOT / "stations/library/jiaopei.yaml").read_text("utf-8")
     (pytester.path / "test_jiaopei.yaml").write_text(station, encoding="utf-8")  # a station file: not a script
     (pytester.path / "other.yaml").write_text(SCRIPT, encoding="utf-8")  # no pattern: not collected
     result = pytester.runpytest(*QUIET, "--junitxml=report.xml")

@@ -1,4 +1,4 @@
-"""The bundled station library (``liansuo/stations/library/*.yaml``), addressable by name or by path."""
+"""The bundled station library (``stations/library/*.yaml``), addressable by name or by path."""
 
 from __future__ import annotations
 
