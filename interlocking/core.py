@@ -1,0 +1,417 @@
+"""The interlocking's core: its state, its inputs, its turnouts and the conditions a signal needs.
+
+The core reads the relay board (inputs that changed since the last cycle), supervises the turnouts and their move
+queue, supervises lamps and the flasher, and answers what keeps a signal closed (:meth:`Core.open_blocker`). It never
+reads the wall clock (the cycle is given the simulated time) and never sees trains: only track relays. Routes move
+through their stages in :mod:`.lifecycle`; every lock is in the ledger (:mod:`.locks`); :class:`~.cbi.Interlocking`
+runs the cycle. Work per cycle is proportional to what is in progress (active routes, moving turnouts, changed
+inputs), not to the size of the station.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from dataclasses import dataclass
+
+from liansuo.stations.schema import SectionRole
+from liansuo.stations.station import Station
+
+from .aspects import GUIDE_ASPECT, downgrade, is_open, onward_allows_usu, select_aspect, stop_aspect
+from .autoblock import AutoBlock, cab_codes
+from .block64d import BlockLink, line_pulses_in, line_tracks_changed
+from .io import Alarm, DoorCommand, Event, Outputs, RelayBoard
+from .locks import Hold, LockLedger
+from .route import InterlockingTable, Route
+from .rules import RuleSet, load_rules
+from .state import GuideOnly, RouteState, SignalState, TurnoutState
+
+MAX_EVENTS = 20_000
+# sections the interlocking locks at power-up (上电锁闭): all of the station's own, not the lines'
+INTERLOCKED = frozenset({SectionRole.throat, SectionRole.station_track, SectionRole.spur})
+
+
+@dataclass
+class Changes:
+    """What changed on the relay board since the last cycle."""
+
+    tracks: set[str]
+    turnouts: set[str]
+    signals: set[str]
+    pulses: dict[str, set[str]]
+    commanded: bool  # aspects set by operator commands since the last cycle
+
+
+class Core:
+    """One station's interlocking state. ``locked_at_start``: the state after power-up (上电): every section locked
+    and every signal closed until the operator's power-up release."""
+
+    def __init__(self, table: InterlockingTable, rules: RuleSet | None = None, cycle_s: float = 0.25, *,
+                 locked_at_start: bool = False) -> None:
+        self.table = table
+        self.station: Station = table.station
+        self.rules = rules or load_rules()
+        self.cycle_s = cycle_s
+        self.board = RelayBoard()
+        self.out = Outputs()
+        self.now = 0.0
+        self.cycles = 0
+        self.routes: dict[str, RouteState] = {}  # active routes in order of selection
+        self.by_signal: dict[str, str] = {}
+        st = self.station
+        self.locks = LockLedger(st.turnout_section, st.pairs)
+        self.overlap_pending: dict[str, float | None] = {}  # route -> when its overlap releases (after the route)
+        self.turnouts = {t: TurnoutState(t, st.turnout_section[t], st.turnouts[t].trailable) for t in st.turnouts}
+        self.signals = {s.id: SignalState(s.id, stop_aspect(st, s.id)) for s in st.model.signals}
+        for sig in st.model.signals:
+            self.out.set_aspect(sig.id, stop_aspect(st, sig.id))
+        self.links = {lk.id: BlockLink(lk.id, lk.sections[0] if lk.sections else "")
+                      for lk in st.model.links if lk.kind.value == "64d"}
+        self.auto_links = {lk.id: tuple(lk.sections) for lk in st.model.links if lk.kind.value == "automatic"}
+        self.line_out: set[str] = set()  # automatic lines whose direction is changed for our departures (改方)
+        self.queue: deque[str] = deque()
+        self.moving: set[str] = set()
+        self.no_indication: set[str] = set(st.turnouts)  # fail-safe: nothing reported yet
+        self.usu_failed: set[str] = set()  # flasher check failed while showing USU: UU until the route releases
+        self.guide_only: dict[str, GuideOnly] = {}  # guide aspect without a route (throat under guide total lock)
+        self.events: deque[Event] = deque(maxlen=MAX_EVENTS)
+        self.alarms: dict[str, Alarm] = {}
+        self.entry_section = {s: st.tracks[st.signal_entry_track(s)].section for s in st.signals}
+        self.signal_by_entry: dict[str, list[str]] = {}
+        for sig_id, sec in self.entry_section.items():
+            self.signal_by_entry.setdefault(sec, []).append(sig_id)
+        self.platform_doors = {p.section: [f"{p.id}:{d.side.value}" for d in p.screen_doors]
+                               for p in st.model.platforms if p.screen_doors}
+        self._throat_platforms: dict[str, list[str]] = {}  # home signal -> platform tracks bordering its throat
+        self.autoblock = AutoBlock(st)
+        self.codes_dirty = True
+        self.blocks_dirty = False  # the automatic block signals must be evaluated again (a line's direction changed)
+        for key in (k for keys in self.platform_doors.values() for k in keys):
+            self.out.doors.setdefault(key, DoorCommand())
+        self.power_up_locked = locked_at_start
+        if locked_at_start:
+            for name, section in st.sections.items():
+                if section.role in INTERLOCKED:
+                    self.locks.lock_section(name, Hold.power_up)
+            self.event("power", "interlocking started: every section locked until the power-up release (上电解锁)")
+
+    # ---- bookkeeping --------------------------------------------------------------------------------------------
+    def event(self, kind: str, text: str) -> None:
+        self.events.append(Event(self.now, kind, text))
+
+    def alarm(self, key: str, text: str) -> None:
+        if key not in self.alarms:
+            self.alarms[key] = Alarm(key, self.now, text)
+            self.event("alarm", text)
+
+    def clear_alarm(self, key: str) -> None:
+        self.alarms.pop(key, None)
+
+    def clear(self, section: str) -> bool:
+        return self.board.clear(section)
+
+    # ---- the cycle: inputs before the routes, outputs after them ----------------------------------------------
+    def take_inputs(self, t: float) -> Changes:
+        self.now = t
+        self.cycles += 1
+        # aspects set since the last cycle's chain update (by operator commands: cancel, reopen, guide) still have to
+        # reach the automatic block signals in rear
+        commanded = bool(self.out.changed_signals)
+        self.out.changed_signals.clear()  # from here on: what this cycle changed
+        self.out.changed_turnouts.clear()
+        tracks, turnouts, signals, _doors, pulses = self.board.take_changes()
+        return Changes(tracks, turnouts, signals, pulses, commanded)
+
+    def apply_inputs(self, ch: Changes) -> None:
+        """The 64D line, turnout indications, lamp proving and the turnout move queue."""
+        for link, msgs in ch.pulses.items():
+            line_pulses_in(self.links, link, msgs, self.event)
+        if ch.tracks and self.links:
+            line_tracks_changed(self.links, ch.tracks, self.clear, self.send, self.event)
+        for t_id in ch.turnouts:
+            if self.board.indication(t_id) is None:
+                if t_id not in self.no_indication:
+                    self.no_indication.add(t_id)
+                    self.turnouts[t_id].no_indication_since = self.now
+            else:
+                self.no_indication.discard(t_id)
+                ts = self.turnouts[t_id]
+                ts.no_indication_since = None
+                if ts.squeeze_alarmed:
+                    ts.squeeze_alarmed = False
+                    self.clear_alarm(f"squeeze:{t_id}")
+        for sig in ch.signals:
+            self._lamp_alarms(sig)
+        self._supervise_turnouts()
+
+    def give_outputs(self, ch: Changes) -> Outputs:
+        """The automatic block signals and the cab codes, after the routes have moved."""
+        if self.autoblock.signals and (ch.tracks or ch.signals or ch.commanded or self.out.changed_signals
+                                       or self.blocks_dirty):
+            self.blocks_dirty = False
+            dark = {s for s, ss in self.signals.items() if ss.red_dark}
+            self.autoblock.update(self.out, self.clear, self.proven, dark, self.line_out)
+        if self.codes_dirty or self.out.changed_signals:
+            self.codes_dirty = False
+            self.out.cab_codes = cab_codes(self.station, self.rules, self.routes.values(), self.out.signals)
+        return self.out
+
+    def _lamp_alarms(self, signal: str) -> None:
+        """Flasher (SNJ/SNJJ) and red-lamp supervision of one signal whose proving relays changed."""
+        sig = self.station.signals[signal]
+        if sig.usu:
+            if self.board.flasher_ok(signal):
+                if signal not in self.usu_failed:
+                    self.clear_alarm(f"flasher:{signal}")
+            else:
+                self.usu_failed.add(signal)
+                self.alarm(f"flasher:{signal}", f"signal {signal}: USU flasher failed (SNJ/SNJJ down); USU "
+                           "degrades to UU")
+        if self.board.filament_alarm.get(signal, False):
+            self.alarm(f"filament:{signal}", f"signal {signal}: main filament broken (主丝断丝), lamp on its backup "
+                       "filament or dark")
+        else:
+            self.clear_alarm(f"filament:{signal}")
+        stop = stop_aspect(self.station, signal)  # the red (or blue) lamp is named as the stop aspect it shows
+        if stop in [lamp.value for lamp in sig.lamps]:
+            dark = not self.board.lamp_ok(signal, stop)
+            if dark != self.signals[signal].red_dark:
+                self.signals[signal].red_dark = dark
+                if dark:
+                    self.alarm(f"red:{signal}", f"signal {signal}: {stop} lamp dark (both filaments)")
+                else:
+                    self.clear_alarm(f"red:{signal}")
+
+    # ---- turnouts -------------------------------------------------------------------------------------------
+    def _supervise_turnouts(self) -> None:
+        for t_id in list(self.moving):
+            ts = self.turnouts[t_id]
+            if not self.clear(ts.section) and self.board.indication(t_id) != ts.target:
+                # a movement entered the turnout's section during the move: stop driving it, so the machine is
+                # never started again under the movement (the turnout stays without indication: fail-safe)
+                self.moving.discard(t_id)
+                self.out.drive(t_id, None)
+                self.alarm(f"move:{t_id}", f"turnout {t_id}: drive to {ts.target} stopped, section {ts.section} "
+                           "became occupied during the move")
+                ts.target = None
+                ts.move_started = None
+                continue
+            if ts.target is not None and self.board.indication(t_id) == ts.target:
+                self.moving.discard(t_id)
+                self.out.drive(t_id, None)
+                self.event("turnout", f"turnout {t_id} in {ts.target}")
+                ts.target = None
+                ts.move_started = None
+                self.clear_alarm(f"move:{t_id}")
+            elif ts.move_started is not None and self.now - ts.move_started > self.rules.turnout_timeout_s:
+                self.moving.discard(t_id)
+                self.out.drive(t_id, None)
+                self.alarm(f"move:{t_id}", f"turnout {t_id} did not reach {ts.target} within "
+                           f"{self.rules.turnout_timeout_s:g} s (no indication)")
+                ts.target = None
+                ts.move_started = None
+        while self.queue and len(self.moving) < self.rules.turnout_concurrency:
+            t_id = self.queue.popleft()
+            ts = self.turnouts[t_id]
+            ts.queued = False
+            if ts.target is None:
+                continue
+            if self.board.indication(t_id) == ts.target:
+                ts.target = None
+                continue
+            if not self.clear(ts.section):
+                # a movement reached the turnout while its move waited in the queue: never drive under it
+                self.event("turnout", f"turnout {t_id} not moved to {ts.target}: section {ts.section} is occupied")
+                ts.target = None
+                continue
+            self.moving.add(t_id)
+            ts.move_started = self.now
+            self.out.drive(t_id, ts.target)
+        for t_id in self.no_indication:
+            ts = self.turnouts[t_id]
+            if t_id in self.moving or ts.queued or ts.squeeze_alarmed or not ts.trailable:
+                continue
+            since = ts.no_indication_since if ts.no_indication_since is not None else 0.0
+            if self.now - since >= self.rules.squeeze_alarm_s:
+                ts.squeeze_alarmed = True
+                self.alarm(f"squeeze:{t_id}", f"turnout {t_id} squeezed (挤岔): no indication for "
+                           f"{self.rules.squeeze_alarm_s:g} s")
+
+    def request_move(self, turnout: str, position: str) -> None:
+        """Queue a move of ``turnout`` (and its crossover partner) to ``position``."""
+        for t_id in self.pair_members(turnout):
+            ts = self.turnouts[t_id]
+            if self.board.indication(t_id) == position and t_id not in self.moving:
+                continue
+            ts.target = position
+            if t_id in self.moving:
+                ts.move_started = self.now
+                self.out.drive(t_id, position)
+            elif not ts.queued:
+                ts.queued = True
+                self.queue.append(t_id)
+
+    def pair_members(self, turnout: str) -> list[str]:
+        pair = self.station.turnouts[turnout].pair
+        return list(self.station.pairs[pair]) if pair else [turnout]
+
+    # ---- what a signal needs (开放信号的条件) -------------------------------------------------------------------
+    def checked_sections(self, rs: RouteState) -> tuple[str, ...]:
+        """Every section that must be clear for the signal: route and run-on, fouling, overlap."""
+        r = rs.route
+        return rs.sections + tuple(f.section for f in r.fouling) + r.overlap_sections
+
+    def open_blocker(self, rs: RouteState, *, guide: bool = False, sections: bool = True) -> str:
+        """Why the signal of ``rs`` may not open (or stay open); '' when every condition holds. ``sections=False``
+        excuses the occupied stretch of the route's sections from its first one on (a shunting consist passing its
+        open signal occupies them), but no section beyond a clear one, nor the fouling and overlap sections."""
+        r = rs.route
+        if any(rs.released):
+            released = [s for i, s in enumerate(rs.sections) if rs.released[i]]
+            return f"section {released[0]} of route {r.id} has been released: the route is no longer locked"
+        for t in rs.all_turnouts:
+            ind = self.board.indication(t.id)
+            if ind != t.position.value:
+                what = "has no indication" if ind is None else f"is {ind}"
+                return f"turnout {t.id} {what}, the route needs it {t.position.value}"
+            if t in rs.turnouts and rs.id not in self.locks.holders(t.id):
+                return f"turnout {t.id} is not locked in route {r.id}"
+        if not guide:
+            skip = 0
+            if not sections:
+                while skip < len(rs.sections) and not self.clear(rs.sections[skip]):
+                    skip += 1
+            for s in self.checked_sections(rs)[skip:]:
+                if not self.clear(s):
+                    return f"section {s} is occupied"
+        blocker = self.liaison_blocker(r)
+        if blocker:
+            return blocker
+        aspect = self.wanted_aspect(rs) if not guide else GUIDE_ASPECT
+        if not is_open(aspect):
+            return self._why_closed(rs)
+        shown = self.proven(r.signal, aspect)
+        if not is_open(shown) or (guide and shown != GUIDE_ASPECT):
+            return f"a lamp of signal {r.signal} for {aspect} is dark"
+        return ""
+
+    def liaison_blocker(self, r: Route) -> str:
+        if r.exit_link in self.links:
+            link = self.links[r.exit_link]
+            if link.state.value != "permitted":
+                return f"block line {link.id} has not been accepted by the neighbour station (64D: {link.state.value})"
+            if not self.clear(link.departure_section):
+                return f"departure section {link.departure_section} is occupied"
+        if r.exit_link in self.auto_links:
+            why = self.against_running(r.exit_link)
+            if why:
+                return why
+            if self._clear_blocks(r.exit_link) == 0:
+                return f"departure section {self.auto_links[r.exit_link][0]} is occupied"
+        occupied = [sec for sec in r.line_sections if not self.clear(sec)]
+        if occupied:
+            return f"line section {occupied[0]} is occupied (no block system is described for this line)"
+        why = self.doors_blocker(self.door_sections(r))
+        if why:
+            return why
+        if r.end_signal is not None and self.signals[r.end_signal].red_dark:
+            return f"the red lamp of {r.end_signal} is dark (红灯转移): {r.signal} must stay closed"
+        return ""
+
+    def against_running(self, link: str) -> str:
+        """Why a departure onto automatic line ``link`` may not go: it runs towards this station and its direction
+        has not been changed (改方); '' when it may."""
+        if self.station.link_running(link) != "inbound" or link in self.line_out:
+            return ""
+        lk = next(x for x in self.station.model.links if x.id == link)
+        if not lk.bidirectional:
+            return (f"line {link} runs towards this station and is not bidirectional: no departure against its "
+                    "running direction")
+        return (f"line {link} runs towards this station: change its direction for departures first (改方, "
+                f"'line-direction {link} out')")
+
+    def doors_blocker(self, sections: list[str]) -> str:
+        """Why screen doors at these platform tracks keep a signal closed; '' when none does."""
+        for sec in sections:
+            for key in self.platform_doors.get(sec, ()):
+                if not self.board.doors_safe(key):
+                    return f"screen doors {key} are not closed and locked (and not bypassed)"
+        return ""
+
+    def guide_only_doors(self, signal: str) -> list[str]:
+        """The platform tracks a guided train may reach from ``signal`` under guide total lock, where the
+        interlocking does not know the way (a turnout may have been trailed through): every platform track that
+        borders the throat the signal leads into, whichever way its turnouts lie."""
+        if signal not in self._throat_platforms:
+            st = self.station
+            outside = (SectionRole.station_track, SectionRole.approach, SectionRole.block, SectionRole.departure)
+            start = st.signal_entry_track(signal)
+            seen, todo, border = {start}, [start], []
+            while todo:
+                track = todo.pop()
+                for port in st.track_ports[track]:
+                    for _, nxt in st.node_tracks[port.node]:
+                        sec = st.tracks[nxt].section
+                        if nxt in seen:
+                            continue
+                        seen.add(nxt)
+                        if sec in self.platform_doors:
+                            border.append(sec)
+                        elif st.sections[sec].role not in outside:
+                            todo.append(nxt)
+            self._throat_platforms[signal] = sorted(set(border))
+        return self._throat_platforms[signal]
+
+    def door_sections(self, r: Route) -> list[str]:
+        out = [s for s in r.sections if s in self.platform_doors]
+        rear = self.station.signal_rear_track(r.signal)
+        if rear is not None:
+            sec = self.station.tracks[rear].section
+            if sec in self.platform_doors and sec not in out:
+                out.append(sec)
+        return out
+
+    def _clear_blocks(self, link: str) -> int:
+        sections = self.auto_links[link]
+        if link in self.line_out:  # worked against its running direction: the whole line is one block
+            return 3 if all(self.clear(s) for s in sections) else 0
+        n = 0
+        for s in sections[:3]:
+            if not self.clear(s):
+                break
+            n += 1
+        return n
+
+    def _why_closed(self, rs: RouteState) -> str:
+        r = rs.route
+        if r.category == "departure" and r.exit_link in self.auto_links:
+            return f"no clear block section beyond {r.signal}"
+        return f"signal {r.signal} has no proceed aspect for route {r.id}"
+
+    def wanted_aspect(self, rs: RouteState) -> str:
+        r = rs.route
+        next_aspect = self.out.signals.get(r.end_signal, "") if r.end_signal else ""
+        clear_blocks = self._clear_blocks(r.exit_link) if r.exit_link in self.auto_links else None
+        onward = self.route_of(r.end_signal) if r.end_signal else None
+        usu_ready = (bool(r.end_signal) and is_open(next_aspect) and self.board.flasher_ok(r.signal)
+                     and r.signal not in self.usu_failed and onward is not None
+                     and onward_allows_usu(self.station, onward.turnouts, self.rules))
+        return select_aspect(self.station, r, next_aspect, clear_blocks, usu_ready, self.rules)
+
+    def route_of(self, signal: str) -> RouteState | None:
+        rid = self.by_signal.get(signal)
+        return self.routes.get(rid) if rid else None
+
+    def proven(self, signal: str, aspect: str) -> str:
+        """The aspect after lamp proving: never more permissive than ``aspect``."""
+        dark = {lamp for lamp in self.rules.lamps.get(aspect, []) if not self.board.lamp_ok(signal, lamp)}
+        if aspect == "USU" and not self.board.flasher_ok(signal):
+            dark.add("flasher")
+        if not dark:
+            return aspect
+        shown = downgrade(aspect, dark, self.rules)
+        self.alarm(f"lamp:{signal}:{aspect}", f"signal {signal}: lamp(s) {', '.join(sorted(dark))} dark for "
+                   f"{aspect}; showing {shown}")
+        return shown
+
+    def send(self, link: str, pulse: str) -> None:
+        self.out.line_out.setdefault(link, set()).add(pulse)
