@@ -29,6 +29,9 @@ def is_open(aspect: str) -> bool:
     return aspect not in STOP and aspect != ""
 
 
+GUIDE_ASPECT = "HB"  # 引导信号: red and moon-white
+
+
 def stop_aspect(station: Station, signal: str) -> str:
     return "A" if station.signals[signal].kind is SignalKind.shunting else "H"
 

@@ -77,7 +77,7 @@ def cab_codes(station: Station, rules: RuleSet, routes: Iterable[RouteState],
     codes: dict[str, str | None] = {s.id: None for s in station.model.sections if s.coded}
     for rs in routes:
         r = rs.route
-        if r.kind != "train" or rs.stage not in (RouteStage.open, RouteStage.in_use):
+        if r.kind != "train" or rs.stage not in (RouteStage.open, RouteStage.guide, RouteStage.in_use):
             continue
         governing = r.end_signal if r.end_signal else r.signal
         code = rules.cab_codes.get(aspects.get(governing, "H"))

@@ -10,11 +10,13 @@ from .route import Route, RouteTurnout, RunOn
 
 
 class RouteStage(StrEnum):
-    """Route lifecycle of one real CBI: selected -> turnouts moving -> locked -> open -> in use -> released."""
+    """The stages of a route in one real CBI (the state machine is :mod:`.lifecycle`)."""
 
     setting = "setting"  # selected; turnouts being moved into position
-    locked = "locked"  # turnouts in position and locked; signal closed (not yet opened, or closed abnormally)
-    open = "open"  # signal open
+    locked = "locked"  # turnouts in position and locked; the signal not yet given
+    open = "open"  # the signal shows a proceed aspect
+    guide = "guide"  # the signal shows the guide aspect (引导), the route's track circuits not checked
+    closed = "closed"  # the signal was given and closed again (abnormally, or an unused guide aspect): 'reopen'
     in_use = "in_use"  # a train has entered; sections release one by one behind it
     time_release = "time_release"  # manual time release counting down (总人解 / 区故解 delay)
 
@@ -25,17 +27,13 @@ class RouteState:
     stage: RouteStage
     since: float
     run_on: RunOn | None = None  # the way a shunting movement runs on past the end, chosen when set
-    guide: bool = False  # opened as a guide route (HB)
-    opened_once: bool = False  # the signal has been open at least once (approach locking applies)
-    needs_reopen: bool = False  # closed abnormally; only 'reopen' opens it again
     entered: bool = False  # the first section has been occupied
     released: list[bool] = field(default_factory=list)
     was_occupied: list[bool] = field(default_factory=list)
     release_at: float | None = None  # when a time release completes
-    close_reason: str = ""
-    overlap_release_at: float | None = None
+    overlap_release_at: float | None = None  # when the overlap releases, once the train reached the route's end
     guide_first_clear: bool = False  # under a guide aspect: the first section was clear when it opened
-    guide_approach_seen: bool = False
+    guide_approach_seen: bool = False  # under a guide aspect: the guided train has been seen approaching
 
     def __post_init__(self) -> None:
         n = len(self.sections)
@@ -64,6 +62,14 @@ class RouteState:
     @property
     def all_turnouts(self) -> tuple[RouteTurnout, ...]:
         return self.turnouts + self.route.overlap_turnouts
+
+
+@dataclass
+class GuideOnly:
+    """A guide aspect given without a route, over a throat under guide total lock (引导总锁闭)."""
+
+    since: float
+    approach_seen: bool = False
 
 
 @dataclass

@@ -18,8 +18,9 @@ from unittest import mock
 import liansuo.interlocking.autoblock as autoblock
 import liansuo.interlocking.block64d as block64d
 import liansuo.interlocking.conflicts as conflicts
+import liansuo.interlocking.core as core
 import liansuo.interlocking.derive as derive
-import liansuo.interlocking.engine as engine
+import liansuo.interlocking.lifecycle as lifecycle
 import liansuo.interlocking.locks as locks
 import liansuo.interlocking.operations as operations
 from liansuo.interlocking.io import RelayBoard, Result
@@ -78,7 +79,7 @@ def _guide_over_lost_indication(s: ExitStack) -> None:
             why = real(self, rs, guide=guide, **kw)
             return "" if guide and why.startswith("turnout") else why
         return open_blocker
-    _wrap(s, engine.Engine, "open_blocker", blind)
+    _wrap(s, core.Core, "open_blocker", blind)
 
 
 def _no_run_on(s: ExitStack) -> None:
@@ -110,16 +111,16 @@ def _no_conflict_table(s: ExitStack) -> None:
 
 # ---- the running interlocking ---------------------------------------------------------------------------------------
 def _usu_without_onward(s: ExitStack) -> None:
-    _patch(s, engine, "onward_allows_usu", lambda station, turnouts, rules: True)
+    _patch(s, core, "onward_allows_usu", lambda station, turnouts, rules: True)
 
 
 def _throw_ignores_locks(s: ExitStack) -> None:
     def throw(real: Any) -> Any:
         def careless(self: Any, name: str, position: str) -> Result:
-            with mock.patch.object(self.locks, "why_turnout", lambda t: ""):
+            with mock.patch.object(self.il.locks, "why_turnout", lambda t: ""):
                 return real(self, name, position)  # type: ignore[no-any-return]
         return careless
-    _wrap(s, operations.Interlocking, "throw", throw)
+    _wrap(s, operations.Operator, "throw", throw)
 
 
 def _throw_ignores_section_locks(s: ExitStack) -> None:
@@ -135,7 +136,7 @@ def _open_blocker_ignoring(s: ExitStack, ignored: Callable[[str], bool]) -> None
             why = real(self, rs, **kw)
             return "" if ignored(why) else why
         return open_blocker
-    _wrap(s, engine.Engine, "open_blocker", blind)
+    _wrap(s, core.Core, "open_blocker", blind)
 
 
 def _blind_to_occupancy(s: ExitStack) -> None:
@@ -149,33 +150,33 @@ def _blind_to_indication(s: ExitStack) -> None:
 def _reopens_by_itself(s: ExitStack) -> None:
     def advance(real: Any) -> Any:
         def forgetful(self: Any, rs: RouteState) -> None:
-            if rs.stage is RouteStage.locked and rs.needs_reopen:
-                rs.needs_reopen = rs.opened_once = False
+            if rs.stage is RouteStage.closed:
+                rs.stage = RouteStage.locked
             real(self, rs)
         return forgetful
-    _wrap(s, engine.Engine, "_advance", advance)
+    _wrap(s, lifecycle.RouteLifecycle, "advance", advance)
 
 
 def _no_three_point_check(s: ExitStack) -> None:
     def release(self: Any, rs: RouteState) -> None:  # a section releases once it is clear again, whatever is next
         secs = rs.sections
         for i, sec in enumerate(secs):
-            if not rs.released[i] and not self.clear(sec):
+            if not rs.released[i] and not self.il.clear(sec):
                 rs.was_occupied[i] = True
         for i, sec in enumerate(secs):
-            if not rs.released[i] and rs.was_occupied[i] and (self.clear(sec) or i == len(secs) - 1):
-                self._release_section(rs, i)
+            if not rs.released[i] and rs.was_occupied[i] and (self.il.clear(sec) or i == len(secs) - 1):
+                self.release_section(rs, i)
         if all(rs.released):
             self.finish(rs, all_sections=False)
-    _patch(s, engine.Engine, "_sequential_release", release)
+    _patch(s, lifecycle.RouteLifecycle, "_sequential_release", release)
 
 
 def _cancel_ignores_approach(s: ExitStack) -> None:
-    _patch(s, operations.Interlocking, "approach_locked", lambda self, rs: False)
+    _patch(s, lifecycle.RouteLifecycle, "approach_locked", lambda self, rs: False)
 
 
 def _no_release_delay(s: ExitStack) -> None:
-    _patch(s, operations.Interlocking, "release_delay", lambda self, r: 0.0)
+    _patch(s, operations.Operator, "release_delay", lambda self, r: 0.0)
 
 
 def _no_red_lamp_check(s: ExitStack) -> None:
@@ -184,7 +185,7 @@ def _no_red_lamp_check(s: ExitStack) -> None:
             real(self, signal)
             self.signals[signal].red_dark = False
         return deaf
-    _wrap(s, engine.Engine, "_lamp_alarms", lamp_alarms)
+    _wrap(s, core.Core, "_lamp_alarms", lamp_alarms)
 
 
 def _no_red_lamp_transfer_on_the_line(s: ExitStack) -> None:
@@ -193,7 +194,7 @@ def _no_red_lamp_transfer_on_the_line(s: ExitStack) -> None:
 
 
 def _no_lamp_proving(s: ExitStack) -> None:
-    _patch(s, engine.Engine, "_proven", lambda self, signal, aspect: aspect)
+    _patch(s, core.Core, "proven", lambda self, signal, aspect: aspect)
 
 
 def _deaf_to_flash_check(s: ExitStack) -> None:
@@ -210,7 +211,7 @@ def _no_64d_check(s: ExitStack) -> None:
             why = real(self, r)
             return "" if why.startswith("block line") else why
         return careless
-    _wrap(s, engine.Engine, "_liaison_blocker", liaison)
+    _wrap(s, core.Core, "liaison_blocker", liaison)
 
 
 def _block_over_occupied_line(s: ExitStack) -> None:
@@ -222,7 +223,7 @@ def _block_over_occupied_line(s: ExitStack) -> None:
 
 
 def _guide_lock_ignores_doors(s: ExitStack) -> None:
-    _patch(s, engine.Engine, "guide_only_doors", lambda self, signal: [])
+    _patch(s, core.Core, "guide_only_doors", lambda self, signal: [])
 
 
 def _line_without_block_unchecked(s: ExitStack) -> None:
@@ -230,19 +231,19 @@ def _line_without_block_unchecked(s: ExitStack) -> None:
 
 
 def _against_running_allowed(s: ExitStack) -> None:
-    _patch(s, engine.Engine, "against_running", lambda self, link: "")
+    _patch(s, core.Core, "against_running", lambda self, link: "")
 
 
 def _guide_stays_open(s: ExitStack) -> None:
     def guide(real: Any) -> Any:
         def late(self: Any, signal: str) -> Result:
             result = real(self, signal)
-            rs = self.route_of(signal)
+            rs = self.il.route_of(signal)
             if rs is not None:
                 rs.guide_first_clear = False  # closes only once the train is past, not when it enters
             return result  # type: ignore[no-any-return]
         return late
-    _wrap(s, operations.Interlocking, "guide", guide)
+    _wrap(s, operations.Operator, "guide", guide)
 
 
 def _no_power_up_lock(s: ExitStack) -> None:
@@ -250,7 +251,7 @@ def _no_power_up_lock(s: ExitStack) -> None:
         def unlocked(self: Any, *args: Any, locked_at_start: bool = False, **kw: Any) -> None:
             real(self, *args, locked_at_start=False, **kw)
         return unlocked
-    _wrap(s, engine.Engine, "__init__", init)
+    _wrap(s, core.Core, "__init__", init)
 
 
 def _overlap_released_at_once(s: ExitStack) -> None:
@@ -258,20 +259,20 @@ def _overlap_released_at_once(s: ExitStack) -> None:
         def hasty(self: Any, rs: RouteState) -> None:
             real(self, rs)
             if rs.overlap_release_at is not None:
-                rs.overlap_release_at = min(rs.overlap_release_at, self.now)
+                rs.overlap_release_at = min(rs.overlap_release_at, self.il.now)
         return hasty
-    _wrap(s, engine.Engine, "_sequential_release", release)
+    _wrap(s, lifecycle.RouteLifecycle, "_sequential_release", release)
 
 
 def _table_conflicts_skipped(s: ExitStack) -> None:
-    _patch(s, operations.Interlocking, "_conditional", lambda self, r, rs: "")
+    _patch(s, operations.Operator, "_conditional", lambda self, r, rs: "")
 
     def blocker(real: Any) -> Any:
         def careless(self: Any, r: Route, run_on: Any = None) -> str:
             with mock.patch.object(r, "conflicts", {}):
                 return real(self, r, run_on)  # type: ignore[no-any-return]
         return careless
-    _wrap(s, operations.Interlocking, "route_blocker", blocker)
+    _wrap(s, operations.Operator, "route_blocker", blocker)
 
 
 def _route_ignores_locked_sections(s: ExitStack) -> None:
@@ -280,7 +281,7 @@ def _route_ignores_locked_sections(s: ExitStack) -> None:
             why = real(self, r, run_on)
             return "" if why.startswith("section") and "is locked" in why else why
         return careless
-    _wrap(s, operations.Interlocking, "route_blocker", blocker)
+    _wrap(s, operations.Operator, "route_blocker", blocker)
 
 
 MUTANTS: tuple[Mutant, ...] = (

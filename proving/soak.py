@@ -83,7 +83,7 @@ class StepGenerator:
 
     def signal_op(self) -> list[str]:
         il = self.sim.interlocking
-        busy = list(il.by_signal) + list(il.guide_only)
+        busy = list(il.by_signal) + list(il.core.guide_only)
         sig = self.rng.choice(busy) if busy and self.rng.random() < 0.85 else self.rng.choice(self.signals)
         op = self.rng.choices(["cancel", "release", "reopen", "guide"], [4, 3, 4, 1])[0]
         if op == "release" and self.rng.random() < 0.3:

@@ -12,11 +12,10 @@ from pathlib import Path
 
 from liansuo.circuits.field import Field
 from liansuo.circuits.railgeometry import Axle
+from liansuo.interlocking.cbi import Interlocking
 from liansuo.interlocking.io import Event, Result
 from liansuo.interlocking.locks import Hold
-from liansuo.interlocking.operations import Interlocking
 from liansuo.interlocking.rules import RuleSet, load_rules
-from liansuo.interlocking.state import RouteStage
 from liansuo.interlocking.table import InterlockingTable, build_table
 from liansuo.stations.loader import load
 from liansuo.stations.station import Station
@@ -89,7 +88,7 @@ class Simulation:
         closes, and the station stays locked (上电锁闭) until the operator's power-up release. The field keeps what
         it had: turnouts lie where they lay, trains stay where they are."""
         self.interlocking = Interlocking(self.table, self.rules, self.cycle_s, locked_at_start=True)
-        self.interlocking.now = self.t
+        self.interlocking.core.now = self.t
         self.wiring.relight()
         self.wiring.publish(self.interlocking.board, everything=True)
         self.neighbours.publish(self.interlocking.board)
@@ -156,11 +155,7 @@ class Simulation:
 
     def route_state(self, route_id: str) -> str:
         rs = self.interlocking.routes.get(route_id)
-        if rs is None:
-            return "released"
-        if rs.stage is RouteStage.open:
-            return "open"
-        return rs.stage.value
+        return "released" if rs is None else rs.stage.value
 
     def section_state(self, section: str) -> str:
         if not self.interlocking.board.clear(section):

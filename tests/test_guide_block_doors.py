@@ -67,7 +67,7 @@ def test_64d_receiving_accept_arrive_restore(jiaopei: Driver) -> None:
 
 def test_64d_accident_button_forces_the_line_back_and_is_counted(jiaopei: Driver) -> None:
     jiaopei("block-line SL request", "run 4s", "block-line SL accident", "expect block-line SL idle")
-    assert jiaopei.sim.interlocking.links["SL"].accidents == 1
+    assert jiaopei.sim.interlocking.core.links["SL"].accidents == 1
 
 
 # ---- platform screen doors (gaotie: P3 on 3G, P4 on 4G) -------------------------------------------------------

@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 import yaml
 
-from liansuo.interlocking.engine import Engine
+from liansuo.interlocking.lifecycle import RouteLifecycle
 from liansuo.interlocking.state import RouteStage, RouteState
 from liansuo.proving.soak import soak
 from liansuo.simulation.cli import main
@@ -38,9 +38,9 @@ def test_the_generator_exercises_the_whole_language() -> None:
 
 
 def forgetful(real: object) -> object:
-    def advance(self: Engine, rs: RouteState) -> None:  # an interlocking that reopens a signal by itself
-        if rs.stage is RouteStage.locked and rs.needs_reopen:
-            rs.needs_reopen = rs.opened_once = False
+    def advance(self: RouteLifecycle, rs: RouteState) -> None:  # an interlocking that reopens a signal by itself
+        if rs.stage is RouteStage.closed:
+            rs.stage = RouteStage.locked
         real(self, rs)  # type: ignore[operator]
 
     return advance
@@ -49,7 +49,7 @@ def forgetful(real: object) -> object:
 def test_a_violation_comes_with_a_short_reproducer_that_replays_it(monkeypatch: pytest.MonkeyPatch,
                                                                     tmp_path: Path,
                                                                     capsys: pytest.CaptureFixture[str]) -> None:
-    monkeypatch.setattr(Engine, "_advance", forgetful(Engine._advance))
+    monkeypatch.setattr(RouteLifecycle, "advance", forgetful(RouteLifecycle.advance))
     assert main(["soak", "jiaopei", "--steps", "200", "--seed", "8", "--format", "json",
                  "--out", str(tmp_path)]) == 1
     rep = json.loads(capsys.readouterr().out)

@@ -8,7 +8,8 @@ from pathlib import Path
 
 import pytest
 
-from liansuo.interlocking.operations import Interlocking
+from liansuo.interlocking.lifecycle import RouteLifecycle
+from liansuo.interlocking.operations import Operator
 from liansuo.proving.scripts import Script, ScriptTest, Step, run_test
 from liansuo.proving.verify import verify_station
 from liansuo.simulation.cli import main
@@ -78,7 +79,7 @@ def test_overlap_is_locked_with_the_route_and_released_by_its_timer(tmp_path: Pa
 
 def test_a_broken_interlocking_fails_with_a_script_that_replays_it(monkeypatch: pytest.MonkeyPatch) -> None:
     # an interlocking that forgets approach locking (接近锁闭): cancel is granted with a train approaching
-    monkeypatch.setattr(Interlocking, "approach_locked", lambda self, rs: False)
+    monkeypatch.setattr(RouteLifecycle, "approach_locked", lambda self, rs: False)
     rep = verify_station("jiaopei", routes=["X-XI"], pairs=False)
     fail = next(f for f in rep.failures if f.check == "approach-locking")
     assert fail.subject == "X-XI" and "'cancel X' with approach IAG occupied was accepted" in fail.detail
@@ -95,7 +96,7 @@ def test_a_broken_interlocking_fails_with_a_script_that_replays_it(monkeypatch: 
 
 
 def test_a_conflict_the_interlocking_lets_through_is_caught(monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setattr(Interlocking, "route_blocker", lambda self, r, run_on=None: "")
+    monkeypatch.setattr(Operator, "route_blocker", lambda self, r, run_on=None: "")
     rep = verify_station("jiaopei", routes=["X-XI"])
     fail = next(f for f in rep.failures if f.check == "conflict")
     assert "conflicts with" in fail.detail and len([s for s in fail.steps if s.startswith(("route", "shunt"))]) == 2

@@ -14,7 +14,7 @@ if TYPE_CHECKING:
 
 _EXPECT = {
     "signal": ("SIGNAL", "L|LL|LU|U|UU|USU|H|HB|B|A"),
-    "route": ("START", "END", "setting|locked|open|in_use|time_release|released"),
+    "route": ("START", "END", "setting|locked|open|guide|closed|in_use|time_release|released"),
     "turnout": ("TURNOUT", "normal|reverse|none", "locked"),
     "section": ("SECTION", "free|locked|occupied"),
     "block-line": ("LINK", "idle|requested|permitted|departed|asked|accepted|arriving|arrived"),

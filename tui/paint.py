@@ -67,7 +67,7 @@ def read_frame(sim: Simulation, lay: Layout) -> Frame:
     st = sim.station
     sections = {s: sim.section_state(s) for s in st.sections}
     turnouts: dict[str, tuple[str | None, str]] = {}
-    for t in il.turnouts:
+    for t in il.core.turnouts:
         turnouts[t] = (il.board.indication(t), sim.turnout_mark(t))
     lamps: dict[str, list[tuple[str, bool]]] = {}
     for sig in st.model.signals:

@@ -141,7 +141,7 @@ class Probe:
         rs = self.sim.interlocking.routes.get(route.id)
         if rs is None:
             return f"route {route.id} is not set"
-        why = self.sim.interlocking.open_blocker(rs)
+        why = self.sim.interlocking.core.open_blocker(rs)
         return f"route {route.id} is {rs.stage.value}" + (f": {why}" if why else "")
 
 
@@ -168,10 +168,10 @@ def prepare(p: Probe, r: Route) -> None:
     """Liaison a route needs before its signal may open: a 64D departure asks the neighbour (闭塞) and waits for
     its acceptance; a departure against the running direction of a bidirectional line changes its direction (改方)."""
     il = p.sim.interlocking
-    if r.exit_link in il.auto_links and against_running(p.ctx.station, r.exit_link) \
+    if r.exit_link in il.core.auto_links and against_running(p.ctx.station, r.exit_link) \
             and not p.sim.line_outbound(r.exit_link):
         p.do(f"line-direction {r.exit_link} out")
-    link = il.links.get(r.exit_link or "")
+    link = il.core.links.get(r.exit_link or "")
     if link is None or link.state.value != "idle":
         return
     p.do(f"block-line {link.id} request")

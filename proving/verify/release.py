@@ -71,7 +71,7 @@ class ReleaseChecks:
         self.rt.check(not result.ok and p.state(r) != "released", "approach-locking",
                       f"'cancel {r.signal}' with approach {', '.join(r.approach)} occupied was accepted", p)
         result = p.do(f"release {r.signal}")
-        delay = p.sim.interlocking.release_delay(r)
+        delay = p.sim.interlocking.operator.release_delay(r)
         p.run(1.0)
         ok = result.ok and p.closed(r.signal) and p.state(r) == "time_release"
         if not self.rt.check(ok, "time-release", f"'release {r.signal}': {result.message}; signal shows "
@@ -98,7 +98,7 @@ class ReleaseChecks:
         if not self.rt.opened(p, "opens"):
             return
         rs = p.sim.interlocking.routes[r.id]
-        sig, secs, beyond = r.signal, rs.sections, p.sim.interlocking.beyond(rs)  # with the run-on, if any
+        sig, secs, beyond = r.signal, rs.sections, p.sim.interlocking.lifecycle.beyond(rs)  # with the run-on, if any
         for s in r.approach:
             p.do(f"occupy {s}")
         p.run(1.0)

@@ -25,7 +25,7 @@ def platform_doors(sim: Simulation) -> None:
         if ps is None:
             continue
         if ps.state == "stopped":
-            result = sim.interlocking.doors(ps.platform, "open")
+            result = sim.interlocking.operator.doors(ps.platform, "open")
             if result.ok:
                 tr.train_doors_open = True
                 ps.state = "doors_open"
@@ -35,7 +35,7 @@ def platform_doors(sim: Simulation) -> None:
                 sim.log("train", f"train {tr.name}: doors stay closed: {result.message}")
                 ps.state = "closing"
         elif ps.state == "doors_open" and sim.t >= ps.until:
-            sim.interlocking.doors(ps.platform, "close")
+            sim.interlocking.operator.doors(ps.platform, "close")
             tr.train_doors_open = False
             ps.state = "closing"
             sim.log("train", f"train {tr.name}: doors closing at {ps.platform}")

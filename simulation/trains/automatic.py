@@ -67,7 +67,8 @@ def inputs_for(sim: Simulation, tr: Train, ctl: AutoController) -> ShuntingInput
     sig, _dist = _next_signal(sim, tr)
     rid = il.by_signal.get(sig) if sig else None
     rs = il.routes.get(rid) if rid else None
-    locked = rs is not None and rs.stage in (RouteStage.locked, RouteStage.open, RouteStage.in_use)
+    locked = rs is not None and rs.stage in (RouteStage.locked, RouteStage.open, RouteStage.guide, RouteStage.closed,
+                                         RouteStage.in_use)
     front_track, _ = sim.fleet.front(tr)
     front_section = sim.station.tracks[front_track].section if front_track in sim.station.tracks else ""
     in_route = il.locks.section_locked(front_section)

@@ -1,0 +1,73 @@
+"""One station's computer-based interlocking (计算机联锁): the core, the route lifecycle and the operator's commands,
+run cycle by cycle.
+
+Evaluation order per cycle (as in one real CBI): inputs -> signal-passed-at-danger check against last cycle's
+aspects -> 64D line -> turnout supervision and the move queue -> routes in order of selection -> automatic block
+signals -> cab codes. ``cycle(t)`` is given the simulated time; nothing here reads the wall clock.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+
+from .core import Core
+from .io import Alarm, Event, Outputs, RelayBoard
+from .lifecycle import RouteLifecycle
+from .locks import LockLedger
+from .operations import Operator
+from .route import InterlockingTable
+from .rules import RuleSet
+from .state import RouteState
+
+
+class Interlocking:
+    """``core``: the state and what a signal needs; ``lifecycle``: the route state machine; ``operator``: the
+    console's commands (``il.operator.set_route(...)``). ``locked_at_start``: after power-up (上电), every section
+    locked until the power-up release."""
+
+    def __init__(self, table: InterlockingTable, rules: RuleSet | None = None, cycle_s: float = 0.25, *,
+                 locked_at_start: bool = False) -> None:
+        self.core = Core(table, rules, cycle_s, locked_at_start=locked_at_start)
+        self.lifecycle = RouteLifecycle(self.core)
+        self.operator = Operator(self.core, self.lifecycle)
+
+    def cycle(self, t: float) -> Outputs:
+        core = self.core
+        changes = core.take_inputs(t)
+        if changes.tracks:
+            self.lifecycle.check_spad(changes.tracks)
+        core.apply_inputs(changes)
+        self.lifecycle.advance_all()
+        return core.give_outputs(changes)
+
+    # ---- what the world reads of the interlocking's state ------------------------------------------------------
+    @property
+    def out(self) -> Outputs:
+        """The outputs: aspects, turnout drives, doors, cab codes, line pulses."""
+        return self.core.out
+
+    @property
+    def board(self) -> RelayBoard:
+        """The relay inputs as the interlocking last read them."""
+        return self.core.board
+
+    @property
+    def routes(self) -> dict[str, RouteState]:
+        """The routes in progress, in order of selection."""
+        return self.core.routes
+
+    @property
+    def by_signal(self) -> dict[str, str]:
+        return self.core.by_signal
+
+    @property
+    def locks(self) -> LockLedger:
+        return self.core.locks
+
+    @property
+    def alarms(self) -> dict[str, Alarm]:
+        return self.core.alarms
+
+    @property
+    def events(self) -> deque[Event]:
+        return self.core.events

@@ -1,0 +1,394 @@
+"""The life of a route (进路), as one state machine.
+
+Every route in progress is in one :class:`~.state.RouteStage`; each cycle :meth:`RouteLifecycle.advance` calls the
+handler of its stage, and every change of stage, whether the cycle makes it or an operator's command does, is a
+method here::
+
+    setting ──turnouts in position──> locked ──conditions hold──> open ──train enters──> in_use ──> (released)
+                                        │  ^                       │                       ^
+                      guide command ────┼──┼──> guide ─────────────┼──guided train enters──┘
+                                        │  │      │                │
+                                        │  └──────┴──> closed <────┘ a condition lost (alarm); 'reopen' -> open
+                                        └── release (approach locked) ──> time_release ──delay over──> (released)
+
+Cancel and release without a train approaching release the route at once (:meth:`finish`). A section fault release
+(区故解) releases one section (:meth:`release_section`). The locks a route holds are the ledger's (:mod:`.locks`);
+what a signal needs to open is the core's (:meth:`~.core.Core.open_blocker`).
+"""
+
+from __future__ import annotations
+
+from .aspects import GUIDE_ASPECT, is_open, stop_aspect
+from .core import Core
+from .locks import Hold
+from .route import RunOn
+from .state import GuideOnly, RouteStage, RouteState
+
+HANDLERS = {  # the method that runs a route in each stage, one cycle
+    RouteStage.setting: "_setting",
+    RouteStage.locked: "_locked",
+    RouteStage.open: "_keep_open",
+    RouteStage.guide: "_keep_guide",
+    RouteStage.closed: "_closed",
+    RouteStage.in_use: "_sequential_release",
+    RouteStage.time_release: "_time_release",
+}
+# stages in which the signal has been opened: a train approaching makes the route approach-locked (接近锁闭)
+SIGNAL_GIVEN = frozenset({RouteStage.open, RouteStage.guide, RouteStage.closed, RouteStage.time_release})
+
+
+class RouteLifecycle:
+    """The stage handlers and transitions of every route of one interlocking ``core``."""
+
+    def __init__(self, core: Core) -> None:
+        self.il = core
+
+    # ---- the cycle ----------------------------------------------------------------------------------------------
+    def advance_all(self) -> None:
+        for rs in list(self.il.routes.values()):
+            self.advance(rs)
+        self._guide_only()
+        self._overlaps()
+
+    def advance(self, rs: RouteState) -> None:
+        """One cycle of one route: the handler of its stage."""
+        getattr(self, HANDLERS[rs.stage])(rs)
+
+    # ---- selection ----------------------------------------------------------------------------------------------
+    def select(self, rs: RouteState) -> None:
+        """A route accepted by the operator: it takes its locks and its turnouts start moving (setting)."""
+        il, r = self.il, rs.route
+        il.routes[r.id] = rs
+        il.by_signal[r.signal] = r.id
+        for s in rs.sections:
+            il.locks.lock_section(s, Hold.route, r.id)
+        for f in r.fouling:
+            il.locks.lock_section(f.section, Hold.fouling, r.id)
+        for s in r.overlap_sections:
+            il.locks.lock_section(s, Hold.overlap, r.id)
+        for t in rs.turnouts:
+            il.locks.lock_turnout(t.id, Hold.route, r.id)
+        for t in r.overlap_turnouts:
+            il.locks.lock_turnout(t.id, Hold.overlap, r.id)
+        for t in rs.all_turnouts:
+            if il.board.indication(t.id) != t.position.value:
+                il.request_move(t.id, t.position.value)
+        il.codes_dirty = True
+        il.event("route", f"route {r.id} selected")
+
+    # ---- stage handlers -----------------------------------------------------------------------------------------
+    def _setting(self, rs: RouteState) -> None:
+        il = self.il
+        if all(il.board.indication(t.id) == t.position.value for t in rs.all_turnouts):
+            rs.stage = RouteStage.locked
+            rs.since = il.now
+            il.event("route", f"route {rs.id} locked")
+            self._locked(rs)
+
+    def _locked(self, rs: RouteState) -> None:
+        """Locked, the signal not yet given: it opens as soon as every condition holds."""
+        if not self._entered_closed(rs) and not self.il.open_blocker(rs):
+            self.open(rs)
+
+    def _closed(self, rs: RouteState) -> None:
+        """The signal was given and closed again: only the operator opens it again ('reopen', 'guide')."""
+        self._entered_closed(rs)
+
+    def _entered_closed(self, rs: RouteState) -> bool:
+        """A movement entered under the closed signal (detected as SPAD): the route releases behind it."""
+        if rs.entered or self._first_occupied(rs):
+            rs.entered = True
+            rs.stage = RouteStage.in_use
+            return True
+        return False
+
+    def _first_occupied(self, rs: RouteState) -> bool:
+        """A movement is in the first section. With the approach clear an occupied first section is a track-circuit
+        fault (red band), as ``_keep_open`` judges it, not a movement entering: the route stays locked."""
+        r, il = rs.route, self.il
+        if il.clear(r.sections[0]):
+            return False
+        return not (r.approach and all(il.clear(s) for s in r.approach))
+
+    def _keep_open(self, rs: RouteState) -> None:
+        il, r = self.il, rs.route
+        if (not rs.entered and not il.clear(r.sections[0]) and r.approach
+                and all(il.clear(s) for s in r.approach)):
+            # occupied with nobody approaching: a track-circuit fault (red band), not a train entering
+            self.close_signal(rs, f"section {r.sections[0]} is occupied", abnormal=True)
+            return
+        if not il.clear(r.sections[0]):
+            rs.entered = True
+            if r.kind == "shunt" and any(not il.clear(s) for s in r.approach):
+                # a shunting signal stays open until the whole consist is past it; everything else is still checked
+                blocker = il.open_blocker(rs, sections=False)
+                if blocker:
+                    self.close_signal(rs, blocker, abnormal=True)
+                return
+            self.close_signal(rs, f"train entered {r.sections[0]}", abnormal=False)
+            rs.stage = RouteStage.in_use
+            il.codes_dirty = True
+            self._sequential_release(rs)
+            return
+        blocker = il.open_blocker(rs)
+        if blocker:
+            self.close_signal(rs, blocker, abnormal=True)
+            return
+        aspect = il.proven(r.signal, il.wanted_aspect(rs))
+        before = il.out.signals.get(r.signal)
+        if aspect != before:
+            il.out.set_aspect(r.signal, aspect)
+            il.event("signal", f"signal {r.signal}: {before} -> {aspect}")
+
+    def _keep_guide(self, rs: RouteState) -> None:
+        """The guide aspect closes when the guided train enters the first section inside the signal; when that
+        section is the faulty one (already showing occupied), once the train has passed the signal (its approach
+        clear again); unused, after the rule set's time."""
+        il, r = self.il, rs.route
+        for t in rs.all_turnouts:
+            if il.board.indication(t.id) != t.position.value:
+                self.close_signal(rs, f"turnout {t.id} lost its indication", abnormal=True)
+                return
+        if not il.board.lamp_ok(r.signal, stop_aspect(il.station, r.signal)):
+            self.close_signal(rs, "red lamp dark: the guide aspect needs the red lamp lit", abnormal=True)
+            return
+        doors = il.doors_blocker(il.door_sections(r))
+        if doors:
+            self.close_signal(rs, doors, abnormal=True)
+            return
+        approach_occupied = any(not il.clear(s) for s in r.approach)
+        if approach_occupied:
+            rs.guide_approach_seen = True
+        entered = (rs.guide_first_clear and not il.clear(r.sections[0])) or (
+            not rs.guide_first_clear and rs.guide_approach_seen and not approach_occupied)
+        if entered:
+            self.close_signal(rs, f"guided train entered {r.sections[0]}", abnormal=False)
+            rs.stage = RouteStage.in_use
+            rs.entered = True
+        elif not rs.guide_approach_seen and il.now - rs.since > il.rules.guide_close_s:
+            self.close_signal(rs, "guide aspect not used", abnormal=False)
+            rs.stage = RouteStage.closed
+
+    def _time_release(self, rs: RouteState) -> None:
+        il = self.il
+        if any(not il.clear(s) for s in rs.sections):
+            rs.stage = RouteStage.in_use
+            rs.entered = True
+            rs.release_at = None
+            il.event("route", f"time release of {rs.id} abandoned: its route is occupied")
+        elif rs.release_at is not None and il.now >= rs.release_at:
+            il.event("route", f"route {rs.id} released by manual time release")
+            self.finish(rs, all_sections=True)
+
+    def _sequential_release(self, rs: RouteState) -> None:
+        """Normal release with the three-point check: a section releases when the one in rear has released, this
+        one was occupied and is clear again, and the next one is occupied."""
+        il, r = self.il, rs.route
+        secs = rs.sections
+        n = len(secs)
+        any_occupied = False
+        for i, s in enumerate(secs):
+            if not rs.released[i] and not il.clear(s):
+                rs.was_occupied[i] = True
+                any_occupied = True
+        last = n - 1
+        # a shunting movement that drew back out of its route (中途返回): nothing in the route occupied, the section
+        # in rear of the signal occupied again; the sections it passed release without the next one occupied
+        drew_back = r.kind == "shunt" and not any_occupied and any(not il.clear(a) for a in r.approach)
+        if (r.overlap_sections and not rs.released[last] and rs.was_occupied[last]
+                and rs.overlap_release_at is None):
+            rs.overlap_release_at = il.now + r.overlap_release_s
+        for i in range(n):
+            if rs.released[i]:
+                continue
+            if i > 0 and not rs.released[i - 1]:
+                break
+            s = secs[i]
+            if (i == last and r.category == "receiving" and il.station.is_station_track(s)
+                    and rs.was_occupied[i]):
+                self.release_section(rs, i)  # the train stands on the receiving track
+                continue
+            if not rs.was_occupied[i] or not il.clear(s):
+                break
+            nxt = secs[i + 1] if i < last else self.beyond(rs)
+            if nxt is not None and il.clear(nxt) and not drew_back:
+                break  # the movement has not reached the next section
+            self.release_section(rs, i)
+        if drew_back and any(rs.released) and not all(rs.released):
+            # partial release: the shunting movement drew back out of the route
+            for i in range(n):
+                if not rs.released[i]:
+                    self.release_section(rs, i)
+        if all(rs.released):
+            self.finish(rs, all_sections=False)
+
+    def beyond(self, rs: RouteState) -> str | None:
+        """The section just past the route (past its run-on, where it has one)."""
+        ro: RunOn | None = rs.run_on
+        st = self.il.station
+        if ro is None:
+            return rs.route.beyond
+        if ro.leads_into is not None:
+            return ro.leads_into
+        if ro.end_node in st.joints:
+            return st.tracks[st.entry_track(ro.end_node, rs.route.direction)].section
+        return None
+
+    # ---- transitions ----------------------------------------------------------------------------------------
+    def open(self, rs: RouteState) -> None:
+        """locked or closed -> open: the signal shows the aspect the route and the signal ahead call for."""
+        il, r = self.il, rs.route
+        rs.stage = RouteStage.open
+        rs.since = il.now
+        il.signals[r.signal].route = r.id
+        aspect = il.proven(r.signal, il.wanted_aspect(rs))
+        il.out.set_aspect(r.signal, aspect)
+        il.codes_dirty = True
+        il.event("signal", f"signal {r.signal} opened: {aspect} (route {r.id})")
+
+    def reopen(self, rs: RouteState) -> None:
+        """closed -> open (重复开放), the operator having seen the conditions are back."""
+        self.il.clear_alarm(f"closed:{rs.route.signal}")
+        self.open(rs)
+
+    def open_guide(self, rs: RouteState) -> None:
+        """setting, locked or closed -> guide: the guide aspect over the route, its track circuits not checked."""
+        il, signal = self.il, rs.route.signal
+        rs.stage = RouteStage.guide
+        rs.guide_first_clear = il.clear(rs.route.sections[0])
+        rs.guide_approach_seen = False
+        rs.since = il.now
+        il.clear_alarm(f"closed:{signal}")
+        il.signals[signal].route = rs.id
+        il.out.set_aspect(signal, GUIDE_ASPECT)
+        il.codes_dirty = True
+        il.event("signal", f"guide aspect {GUIDE_ASPECT} on {signal} (route {rs.id})")
+
+    def close_signal(self, rs: RouteState, reason: str, *, abnormal: bool) -> None:
+        """Show the stop aspect. ``abnormal``: a condition was lost (-> closed, with an alarm); otherwise the caller
+        moves the route on (a train entered, the route is being released)."""
+        il, r = self.il, rs.route
+        il.out.set_aspect(r.signal, stop_aspect(il.station, r.signal))
+        il.codes_dirty = True
+        if abnormal:
+            rs.stage = RouteStage.closed
+            il.alarm(f"closed:{r.signal}", f"signal {r.signal} closed: {reason}")
+        else:
+            il.event("signal", f"signal {r.signal} closed: {reason}")
+
+    def close_if_open(self, rs: RouteState, reason: str) -> None:
+        if self.il.out.signals.get(rs.route.signal) != stop_aspect(self.il.station, rs.route.signal):
+            self.close_signal(rs, reason, abnormal=False)
+
+    def start_time_release(self, rs: RouteState, delay: float, reason: str) -> None:
+        """-> time_release: the route releases after ``delay`` unless a train enters it (总人解, 区故解 delay)."""
+        self.close_if_open(rs, reason)
+        rs.stage = RouteStage.time_release
+        rs.release_at = self.il.now + delay
+
+    def enter_at_danger(self, rs: RouteState) -> None:
+        """A movement passed the route's closed signal: the route is in use and releases behind it."""
+        rs.entered = True
+        if rs.stage in (RouteStage.time_release, RouteStage.locked, RouteStage.closed):
+            rs.stage = RouteStage.in_use
+            rs.release_at = None
+
+    def release_section(self, rs: RouteState, i: int) -> None:
+        il, s = self.il, rs.sections[i]
+        rs.released[i] = True
+        il.codes_dirty = True
+        il.locks.unlock_section(s, Hold.route, rs.id)
+        for t in rs.turnouts:
+            if il.station.turnout_section[t.id] == s:
+                il.locks.unlock_turnout(t.id, Hold.route, rs.id)
+        il.event("release", f"section {s} released ({rs.id})")
+
+    def finish(self, rs: RouteState, *, all_sections: bool) -> None:
+        """Release the whole route (what is still locked), keeping a running overlap timer."""
+        il, r = self.il, rs.route
+        rs.released = [True] * len(rs.released)
+        il.locks.release(Hold.route, rs.id)
+        il.locks.release(Hold.fouling, rs.id)
+        if r.overlap_sections:
+            if rs.overlap_release_at is not None and not all_sections:
+                il.overlap_pending[rs.id] = rs.overlap_release_at
+            else:
+                self.release_overlap(rs.id)
+        if il.out.signals.get(r.signal) != stop_aspect(il.station, r.signal):
+            il.out.set_aspect(r.signal, stop_aspect(il.station, r.signal))
+        il.signals[r.signal].route = None
+        il.usu_failed.discard(r.signal)
+        il.routes.pop(rs.id, None)
+        if il.by_signal.get(r.signal) == rs.id:
+            del il.by_signal[r.signal]
+        il.clear_alarm(f"closed:{r.signal}")
+        il.codes_dirty = True
+        il.event("route", f"route {r.id} released")
+
+    def release_overlap(self, rid: str) -> None:
+        self.il.overlap_pending.pop(rid, None)
+        self.il.locks.release(Hold.overlap, rid)
+        self.il.event("release", f"overlap of {rid} released")
+
+    def _overlaps(self) -> None:
+        for rid, at in list(self.il.overlap_pending.items()):
+            if at is not None and self.il.now >= at:
+                self.release_overlap(rid)
+
+    # ---- the guide aspect without a route (a throat under guide total lock) ---------------------------------
+    def open_guide_only(self, signal: str) -> None:
+        il = self.il
+        il.guide_only[signal] = GuideOnly(il.now)
+        il.out.set_aspect(signal, GUIDE_ASPECT)
+        il.event("signal", f"guide aspect {GUIDE_ASPECT} on {signal} under guide total lock")
+
+    def close_guide_only(self, signal: str, alarm: str = "") -> None:
+        il = self.il
+        del il.guide_only[signal]
+        il.out.set_aspect(signal, stop_aspect(il.station, signal))
+        if alarm:
+            il.alarm(f"closed:{signal}", f"signal {signal} closed: {alarm}")
+
+    def _guide_only(self) -> None:
+        il = self.il
+        for sig, g in list(il.guide_only.items()):
+            occupied = any(not il.clear(s) for s in il.station.approach_sections(sig))
+            if occupied:
+                g.approach_seen = True
+            entered = not il.clear(il.entry_section[sig])
+            if entered or (not occupied and g.approach_seen) or (
+                    not g.approach_seen and il.now - g.since > il.rules.guide_close_s):
+                self.close_guide_only(sig)
+                il.event("signal", f"guide aspect of {sig} closed")
+            elif not il.board.lamp_ok(sig, stop_aspect(il.station, sig)):
+                self.close_guide_only(sig, "red lamp dark, the guide aspect needs it lit")
+            elif doors := il.doors_blocker(il.guide_only_doors(sig)):
+                self.close_guide_only(sig, doors)
+
+    # ---- signal passed at danger ------------------------------------------------------------------------------
+    def check_spad(self, became: set[str]) -> None:
+        """冒进信号: a section inside a closed signal became occupied with the section in rear occupied."""
+        il, st = self.il, self.il.station
+        for sec in became:
+            if il.clear(sec):
+                continue
+            for sig in il.signal_by_entry.get(sec, ()):
+                if is_open(il.out.signals.get(sig, "")):
+                    continue
+                own = il.by_signal.get(sig)
+                passing = [il.routes[h] for h in il.locks.section_holders(sec, (Hold.route,))
+                           if h != own and h in il.routes]
+                if any(p.route.direction is not st.signals[sig].direction
+                       or st.signals[sig].at in p.route.path.joints for p in passing):
+                    continue  # a movement from the other side, or one running past a signal inside its own route
+                rear = st.signal_rear_track(sig)
+                if rear is None or il.clear(st.tracks[rear].section):
+                    continue
+                il.alarm(f"spad:{sig}:{il.now:.2f}", f"signal {sig} passed at danger (冒进信号): {sec} occupied "
+                         "with the signal closed")
+                if own is not None:
+                    self.enter_at_danger(il.routes[own])
+
+    def approach_locked(self, rs: RouteState) -> bool:
+        """接近锁闭: the signal has been given and a train is in the approach section."""
+        return rs.stage in SIGNAL_GIVEN and any(not self.il.clear(s) for s in rs.route.approach)
