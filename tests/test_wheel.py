@@ -197,24 +197,30 @@ def copy_source(dest: Path) -> Path:
     return dest
 
 
-def unreachable(requirements: list[str], tmp: Path) -> str:
-    """Why pip cannot get these requirements from the index or its cache, or '' when it can (then a failure is ours)."""
-    probe = run([sys.executable, "-m", "pip", "download", "--no-deps", "--dest", tmp / "probe", *requirements], tmp,
-                clean_env())
+def unreachable(requirements: list[str], tmp: Path, *options: str) -> str:
+    """Why pip cannot get these requirements from the index or its cache, or '' when it can."""
+    pip: list[str | Path] = [sys.executable, "-m", "pip", "download", "--no-deps", *options, "--dest", tmp / "probe"]
+    probe = run([*pip, *requirements], tmp, clean_env())
     return "" if probe.returncode == 0 else describe(probe, tmp)
 
 
 def build_or_skip(what: str, args: Sequence[str | Path], cwd: Path, env: dict[str, str], requirements: list[str],
                   tmp: Path) -> None:
+    """Run a step that needs the package index; skip only when pip can neither reach an index nor find the
+    requirements in its cache, fail on anything else."""
     proc = run(args, cwd, env)
     if proc.returncode == 0:
         return
     why = unreachable(requirements, tmp)
-    if why:
-        pytest.skip(f"wheel check impossible here: pip can get {', '.join(requirements)} neither from the package "
-                    f"index nor from its cache, so the wheel cannot be {what}:\n{why}")
-    pytest.fail(f"wheel check: {what} failed (the requirements are reachable, so the failure is the project's)\n"
-                f"{describe(proc, cwd)}", pytrace=False)
+    if not why:
+        pytest.fail(f"wheel check: {what} failed (pip can get {', '.join(requirements)}, so the failure is the "
+                    f"project's)\n{describe(proc, cwd)}", pytrace=False)
+    if not unreachable(["pip"], tmp, "--no-cache-dir"):
+        pytest.fail(f"wheel check: {what} failed: pip reaches a package index (it gets pip without its cache) but not "
+                    f"{', '.join(requirements)}: is a requirement misspelt or pinned to no existing version?\n{why}\n"
+                    f"{describe(proc, cwd)}", pytrace=False)
+    pytest.skip(f"wheel check impossible here: no package index is reachable and pip's cache lacks some of "
+                f"{', '.join(requirements)}, so the wheel cannot be {what}:\n{why}")
 
 
 @pytest.fixture(scope="session")
