@@ -7,9 +7,9 @@ should not be installed would all pass there and break ``pip install liansuo``. 
 ``verify``, a route-test script, ``table``, the Python API, a bundled exercise, the console headless and the pytest
 plugin; a failure names the command that failed, its folder, exit status, stdout and stderr.
 
-One build and one virtual environment serve every test of a run (a session fixture, about half a minute in all). Select
-with ``pytest -m wheel``, leave out with ``-m 'not wheel'``. The only skip: pip can get neither the build requirements
-nor the dependencies, from the package index or its cache.
+One build and one virtual environment serve every test of a run (a session fixture; some 20 s of CPU in all). Select
+with ``pytest -m wheel``, leave out with ``-m 'not wheel'``. The only skip: no package index is reachable and pip's
+cache lacks a requirement, so the wheel can be neither built nor installed.
 """
 
 from __future__ import annotations
