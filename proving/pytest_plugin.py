@@ -11,6 +11,10 @@ YAML are never collected. Each test of a script is one pytest item (``path::test
 and ``-x`` work as for Python tests; a failure shows the step, the expectation and the state, as ``liansuo test``
 does, followed by every step's answer. Set ``liansuo_scripts =`` (empty) in the ini file to collect only scripts
 named on the command line, or disable the plugin with ``-p no:liansuo``.
+
+The entry point loads this module into every pytest run of an environment where liansuo is installed, so it imports
+nothing but pytest at module level: YAML is read only for a ``.yaml`` file that matches, and the station model, the
+interlocking and the simulation are imported only when a script is collected (tests/test_pytest_plugin.py checks it).
 """
 
 from __future__ import annotations
@@ -21,7 +25,6 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import pytest
-import yaml
 
 if TYPE_CHECKING:
     from liansuo.stations.station import Station
@@ -37,6 +40,8 @@ def pytest_addoption(parser: pytest.Parser) -> None:
 
 def is_script(path: Path) -> bool:
     """A YAML mapping with ``station:`` and a ``tests:`` list (read cheaply; errors mean 'not a script')."""
+    import yaml
+
     try:
         with path.open(encoding="utf-8") as fh:
             data = yaml.safe_load(fh)

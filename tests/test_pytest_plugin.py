@@ -3,6 +3,8 @@ other YAML are left alone."""
 
 from __future__ import annotations
 
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -69,3 +71,37 @@ def test_the_example_scripts_run_under_pytest(pytester: pytest.Pytester) -> None
     result = pytester.runpytest(*QUIET, *scripts)
     outcomes = result.parseoutcomes()
     assert outcomes.get("passed", 0) > 20 and "failed" not in outcomes
+
+
+# What the plugin may bring into a pytest run that collects no script: the package root (lazy, tests/test_layout.py)
+# and the plugin itself. The layers, YAML and the heavy dependencies come only with a script.
+LIGHT = {"liansuo", "liansuo.proving", "liansuo.proving.pytest_plugin"}
+HEAVY = ("liansuo", "yaml", "numpy", "textual", "pydantic", "networkx")
+LOADED = f"sorted(m for m in sys.modules if m.startswith({HEAVY!r}))"
+
+
+def packages(modules: set[str]) -> list[str]:
+    """The layers and distributions the modules belong to (liansuo.simulation, numpy, ...), not every submodule."""
+    return sorted({".".join(m.split(".")[:2]) if m.startswith("liansuo.") else m.split(".")[0] for m in modules})
+
+
+def test_importing_the_plugin_imports_no_layer_and_no_heavy_dependency() -> None:
+    code = f"import sys\nimport liansuo.proving.pytest_plugin\nprint(' '.join({LOADED}))"
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=False, cwd=ROOT)
+    assert proc.returncode == 0, proc.stderr
+    loaded = set(proc.stdout.split())
+    assert loaded == LIGHT, f"importing the pytest plugin also imports {packages(loaded - LIGHT)}"
+
+
+def test_a_pytest_run_without_scripts_loads_the_plugin_and_nothing_heavy(pytester: pytest.Pytester) -> None:
+    station = (ROOT / "stations/library/jiaopei.yaml").read_text("utf-8")
+    (pytester.path / "test_jiaopei.yaml").write_text(station, encoding="utf-8")  # matches the patterns, not a script
+    pytester.makepyfile(test_plain=f"import sys\n\ndef test_plain():\n    print('LOADED', *{LOADED})\n")
+    # a fresh interpreter, so that this suite's own imports do not count; pytest-textual-snapshot imports textual
+    result = pytester.runpytest_subprocess(*QUIET, "-s")
+    result.assert_outcomes(passed=1)
+    line = next(line for line in result.outlines if "LOADED" in line)
+    loaded = set(line.split("LOADED", 1)[1].split())
+    assert "liansuo.proving.pytest_plugin" in loaded, f"the pytest11 entry point did not load the plugin: {line}"
+    heavy = {m for m in loaded - LIGHT if m.split(".")[0] != "yaml"}  # YAML: to see that the station is no script
+    assert not heavy, f"a pytest run that collects no script imports {packages(heavy)}"

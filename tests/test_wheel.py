@@ -1,0 +1,334 @@
+"""The wheel as a user gets it: built from the checkout, installed with its dependencies into a fresh virtual
+environment outside the checkout, and run from another folder with no PYTHONPATH.
+
+The rest of the suite runs against the editable install, where the checkout itself is on ``sys.path``: a data file
+missing from ``[tool.setuptools.package-data]``, a layer folder without ``__init__.py`` or a top-level package that
+should not be installed would all pass there and break ``pip install liansuo``. Here the installed ``liansuo`` runs
+``verify``, a route-test script, ``table``, the Python API, a bundled exercise, the console headless and the pytest
+plugin; a failure names the command that failed, its folder, exit status, stdout and stderr.
+
+One build and one virtual environment serve every test of a run (a session fixture; some 20 s of CPU in all). Select
+with ``pytest -m wheel``, leave out with ``-m 'not wheel'``. The only skip: no package index is reachable and pip's
+cache lacks a requirement, so the wheel can be neither built nor installed.
+"""
+
+from __future__ import annotations
+
+import os
+import shlex
+import shutil
+import subprocess
+import sys
+import tomllib
+import zipfile
+from collections.abc import Iterator, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import pytest
+
+pytestmark = pytest.mark.wheel
+
+ROOT = Path(__file__).resolve().parents[1]
+BIN = "Scripts" if os.name == "nt" else "bin"
+# folders of the checkout the build does not read (the wheel is built from a copy, never from the checkout itself,
+# so no build/ folder is left behind and no stale build/lib can hide a file the package data misses)
+NOT_COPIED_AT_TOP = {".venv", ".git", "build", "dist", "tests", "docs", "examples"}
+NOT_COPIED = {"__pycache__", ".pytest_cache", ".mypy_cache", ".ruff_cache", ".hypothesis"}
+# environment variables that would let the installed package see the checkout or another environment
+DROPPED_ENV = {"PYTHONPATH", "PYTHONHOME", "PYTHONSTARTUP", "VIRTUAL_ENV", "PYTHONUSERBASE"}
+TAIL = 60  # lines of stdout and stderr shown when a command fails
+
+ROUTE_SCRIPT = """\
+station: jiaopei
+tests:
+  - name: receiving route opens and the home signal shows yellow
+    steps:
+      - route X XI
+      - run 2s
+      - expect route X XI open
+      - expect signal X U
+      - expect section IG locked
+  - name: a conflicting route is refused
+    steps:
+      - route X XI
+      - route S SI
+      - expect refused conflicting
+"""
+
+API_CHECK = """\
+import liansuo
+
+print("package", liansuo.__file__)
+sim = liansuo.Simulation("jiaopei")
+r = sim.command("route X XI")
+assert r.ok, r
+sim.run(2)
+print("route X-XI", sim.route_state("X-XI"), "signal X", sim.aspect("X"))
+table = liansuo.build_table(liansuo.load_station("jiaopei"))
+print("table", len(table.routes), "routes, X-XI conflicts with", ", ".join(sorted(table.routes["X-XI"].conflicts)[:3]))
+"""
+
+EXERCISE_CHECK = """\
+from liansuo.simulation.exercise import bundled_exercises, check_goal, parse_exercise
+from liansuo.simulation.sim import Simulation
+
+print("bundled", " ".join(p.stem for p in bundled_exercises()))
+ex = parse_exercise("jiaopei-broken-rail-IG")  # by name, as 'liansuo tui --exercise NAME' loads it
+sim = Simulation(ex.station_ref())
+for line in ex.setup:
+    assert sim.command(line).ok, line
+print("before", check_goal(sim, ex).reached)
+assert sim.command("route X X3").ok
+sim.run(15)
+print("after", check_goal(sim, ex).reached, ex.title)
+"""
+
+# The console as tests/test_tui.py drives it: the operator clicks the X and XI train buttons on the diagram, time moves
+# by cycles, and the lamp drawn next to signal X is read from the screen model.
+CONSOLE_CHECK = """\
+import asyncio
+
+from liansuo.tui.app import ConsoleApp
+from liansuo.tui.diagram import Diagram
+from liansuo.tui.layout import Ref
+from liansuo.tui.paint import LAMP_COLOUR, glyph
+
+
+def lamp(app, signal):
+    d = app.diagram
+    d.update_view()
+    for x, y in d.layout_.lamp_slots[signal]:
+        g = d.layout_.at(x, y)
+        if g is not None and g.slot == 0:
+            ch, style = glyph(d.frame(), g, set())
+            return ch, str(style.color.name if style.color else "")
+    raise AssertionError(f"no lamp drawn for signal {signal}")
+
+
+async def main():
+    app = ConsoleApp("jiaopei", paused=True)
+    async with app.run_test(size=(120, 36)) as pilot:
+        print("lamp X before", *lamp(app, "X"), "red" if lamp(app, "X")[1] == LAMP_COLOUR["H"] else "not red")
+        for button in ("X", "XI"):
+            await pilot.click(Diagram, offset=app.diagram.offset_of(Ref("button", button, "train")))
+            await pilot.pause()
+        app.advance(8)
+        app.refresh_views()
+        print("answer", app.message_line.content)
+        print("route X-XI", app.sim.route_state("X-XI"))
+        print("lamp X after", *lamp(app, "X"), "yellow" if lamp(app, "X")[1] == LAMP_COLOUR["U"] else "not yellow")
+
+
+asyncio.run(main())
+"""
+
+PLUGIN_MODULES_CHECK = """\
+import sys
+
+
+def test_the_liansuo_plugin_is_loaded_and_light():
+    loaded = sorted(m for m in sys.modules if m.startswith(("liansuo", "numpy", "textual", "pydantic", "networkx")))
+    print("LOADED", " ".join(loaded))
+"""
+
+
+@dataclass
+class Installed:
+    """The fresh environment with the wheel installed, and a working folder outside the checkout."""
+
+    wheel: Path
+    source: Path  # the copy of the checkout the wheel was built from
+    venv: Path
+    work: Path
+    env: dict[str, str] = field(repr=False)
+
+    @property
+    def python(self) -> str:
+        return str(self.venv / BIN / "python")
+
+    @property
+    def pip(self) -> list[str]:
+        return [sys.executable, "-m", "pip", "--python", self.python]
+
+    @property
+    def liansuo(self) -> str:
+        return str(self.venv / BIN / "liansuo")
+
+
+def clean_env(venv: Path | None = None) -> dict[str, str]:
+    env = {k: v for k, v in os.environ.items() if k not in DROPPED_ENV and not k.startswith("PYTEST_")}
+    if venv is not None:
+        env["PATH"] = f"{venv / BIN}{os.pathsep}{env.get('PATH', '')}"
+        env["VIRTUAL_ENV"] = str(venv)
+        env.pop("PYTHONDONTWRITEBYTECODE", None)  # installed with --no-compile: let the first import write it
+    return env
+
+
+def describe(proc: subprocess.CompletedProcess[str], cwd: Path) -> str:
+    def tail(text: str) -> str:
+        lines = text.rstrip().splitlines()
+        cut = [f"... ({len(lines) - TAIL} lines before)"] if len(lines) > TAIL else []
+        return "\n".join(cut + lines[-TAIL:]) or "(empty)"
+
+    return (f"$ {shlex.join(str(a) for a in proc.args)}\n  (in {cwd}, exit status {proc.returncode})\n"
+            f"--- stdout ---\n{tail(proc.stdout)}\n--- stderr ---\n{tail(proc.stderr)}")
+
+
+def run(args: Sequence[str | Path], cwd: Path, env: dict[str, str]) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([str(a) for a in args], cwd=cwd, env=env, capture_output=True, text=True, timeout=600,
+                          check=False, stdin=subprocess.DEVNULL)
+
+
+def must(what: str, args: Sequence[str | Path], cwd: Path, env: dict[str, str]) -> str:
+    """Run a command that must exit 0; its stdout, or a failure that shows the command, stdout and stderr."""
+    proc = run(args, cwd, env)
+    if proc.returncode != 0:
+        pytest.fail(f"wheel check: {what} failed\n{describe(proc, cwd)}", pytrace=False)
+    return proc.stdout
+
+
+def copy_source(dest: Path) -> Path:
+    def ignore(folder: str, names: list[str]) -> set[str]:
+        top = Path(folder).resolve() == ROOT
+        return {n for n in names if n in NOT_COPIED or n.endswith(".egg-info") or (top and n in NOT_COPIED_AT_TOP)}
+
+    shutil.copytree(ROOT, dest, symlinks=True, ignore=ignore)
+    return dest
+
+
+def unreachable(requirements: list[str], tmp: Path, *options: str) -> str:
+    """Why pip cannot get these requirements from the index or its cache, or '' when it can."""
+    pip: list[str | Path] = [sys.executable, "-m", "pip", "download", "--no-deps", *options, "--dest", tmp / "probe"]
+    probe = run([*pip, *requirements], tmp, clean_env())
+    return "" if probe.returncode == 0 else describe(probe, tmp)
+
+
+def build_or_skip(what: str, args: Sequence[str | Path], cwd: Path, env: dict[str, str], requirements: list[str],
+                  tmp: Path) -> None:
+    """Run a step that needs the package index; skip only when pip can neither reach an index nor find the
+    requirements in its cache, fail on anything else."""
+    proc = run(args, cwd, env)
+    if proc.returncode == 0:
+        return
+    why = unreachable(requirements, tmp)
+    if not why:
+        pytest.fail(f"wheel check: {what} failed (pip can get {', '.join(requirements)}, so the failure is the "
+                    f"project's)\n{describe(proc, cwd)}", pytrace=False)
+    if not unreachable(["pip"], tmp, "--no-cache-dir"):
+        pytest.fail(f"wheel check: {what} failed: pip reaches a package index (it gets pip without its cache) but not "
+                    f"{', '.join(requirements)}: is a requirement misspelt or pinned to no existing version?\n{why}\n"
+                    f"{describe(proc, cwd)}", pytrace=False)
+    pytest.skip(f"wheel check impossible here: no package index is reachable and pip's cache lacks some of "
+                f"{', '.join(requirements)}, so the wheel cannot be {what}:\n{why}")
+
+
+@pytest.fixture(scope="session")
+def installed(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Installed]:
+    tmp = tmp_path_factory.mktemp("wheel")
+    assert not tmp.resolve().is_relative_to(ROOT), f"the temporary folder {tmp} is inside the checkout"
+    try:
+        yield install(tmp)
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)  # the environment takes some 150 MB
+
+
+def install(tmp: Path) -> Installed:
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text("utf-8"))
+    source = copy_source(tmp / "source")
+    dist = tmp / "dist"
+    build_or_skip("built", [sys.executable, "-m", "pip", "wheel", "--no-deps", "--wheel-dir", dist, source], tmp,
+                  clean_env(), list(project["build-system"]["requires"]), tmp)
+    wheels = sorted(dist.glob("liansuo-*.whl"))
+    assert len(wheels) == 1, f"pip wheel left {[w.name for w in dist.iterdir()]} in {dist}, expected one liansuo wheel"
+    venv = tmp / "venv"
+    # without pip of its own: this pip installs into it (--python), which saves seconds and changes nothing installed
+    must("creating a fresh virtual environment", [sys.executable, "-m", "venv", "--without-pip", venv], tmp,
+         clean_env())
+    inst = Installed(wheels[0], source, venv, tmp / "work", clean_env(venv))
+    inst.work.mkdir()
+    # pytest too, for the wheel's pytest11 entry point; bytecode is written as modules are first imported
+    build_or_skip("installed", [*inst.pip, "install", "--no-compile", "--no-warn-script-location", inst.wheel,
+                                "pytest"], tmp, inst.env, [*project["project"]["dependencies"], "pytest"], tmp)
+    return inst
+
+
+def test_the_wheel_holds_the_package_liansuo_only_and_every_file_of_it(installed: Installed) -> None:
+    names = set(zipfile.ZipFile(installed.wheel).namelist())
+    expected = set()
+    for folder, dirs, files in os.walk(installed.source / "liansuo", followlinks=True):
+        dirs[:] = [d for d in dirs if d not in NOT_COPIED]
+        expected |= {(Path(folder) / f).relative_to(installed.source).as_posix() for f in files}
+    missing = sorted(expected - names)
+    assert not missing, ("files of the package are missing from the wheel (a data file needs a line in "
+                         "[tool.setuptools.package-data] of pyproject.toml, a folder of modules an __init__.py):\n  "
+                         + "\n  ".join(missing))
+    out = must("pip show -f liansuo", [*installed.pip, "show", "-f", "liansuo"], installed.work,
+               installed.env)
+    files = [line.strip() for line in out.split("Files:", 1)[-1].splitlines() if line.strip()]
+    roots = {f.split("/")[0] for f in files if not f.startswith("..") and ".dist-info/" not in f}
+    assert roots == {"liansuo"}, f"pip show -f liansuo: the install adds the top-level names {sorted(roots)}, " \
+                                 f"expected only liansuo/:\n{out}"
+    assert any(f.endswith(f"{BIN}/liansuo") for f in files), f"no liansuo console script installed:\n{out}"
+
+
+def test_verify_passes_on_the_bundled_station(installed: Installed) -> None:
+    out = must("liansuo verify jiaopei", [installed.liansuo, "verify", "jiaopei"], installed.work, installed.env)
+    last = out.strip().splitlines()[-1]
+    assert last.startswith("PASS:") and " 0 failures" in last, f"liansuo verify jiaopei ended with: {last}"
+
+
+def test_a_route_test_script_runs(installed: Installed) -> None:
+    (installed.work / "route_test.yaml").write_text(ROUTE_SCRIPT, encoding="utf-8")
+    out = must("liansuo test route_test.yaml", [installed.liansuo, "test", "route_test.yaml"], installed.work,
+               installed.env)
+    assert out.strip().splitlines()[-1] == "2 passed, 0 failed", f"liansuo test route_test.yaml:\n{out}"
+
+
+def test_the_command_line_lists_stations_and_prints_the_table(installed: Installed) -> None:
+    out = must("liansuo stations", [installed.liansuo, "stations"], installed.work, installed.env)
+    assert all(name in out for name in ("jiaopei", "gaotie", "depot")), f"liansuo stations:\n{out}"
+    out = must("liansuo table jiaopei", [installed.liansuo, "table", "jiaopei"], installed.work, installed.env)
+    assert "联锁表" in out and "X-XI" in out and "receiving" in out, f"liansuo table jiaopei:\n{out}"
+    out = must("liansuo tui --help", [installed.liansuo, "tui", "--help"], installed.work, installed.env)
+    assert "--exercise" in out, f"liansuo tui --help:\n{out}"
+
+
+def test_the_public_api_runs_from_the_installed_package(installed: Installed) -> None:
+    out = must("the public API (python -c ...)", [installed.python, "-c", API_CHECK], installed.work, installed.env)
+    package = Path(out.split("package ", 1)[1].splitlines()[0]).resolve()
+    assert package.is_relative_to(installed.venv.resolve()), f"liansuo was imported from {package}, not the venv"
+    assert "route X-XI open signal X U" in out, f"the public API:\n{out}"
+    assert "table 25 routes" in out, f"the public API:\n{out}"
+
+
+def test_a_bundled_exercise_loads_by_name_and_its_goal_is_reached(installed: Installed) -> None:
+    out = must("a bundled exercise (python -c ...)", [installed.python, "-c", EXERCISE_CHECK], installed.work,
+               installed.env)
+    assert "jiaopei-broken-rail-IG" in out.splitlines()[0], f"the bundled exercises:\n{out}"
+    assert "before False" in out and "after True A broken rail in IG" in out, f"the bundled exercise:\n{out}"
+
+
+def test_the_console_sets_a_route_headless(installed: Installed) -> None:
+    script = installed.work / "console_check.py"
+    script.write_text(CONSOLE_CHECK, encoding="utf-8")
+    out = must("the console headless (App.run_test)", [installed.python, script], installed.work, installed.env)
+    for line in ("lamp X before ● #ff2020 red", "answer ✓ route X-XI selected", "route X-XI open",
+                 "lamp X after ● #ffd700 yellow"):
+        assert line in out, f"the console headless: no line {line!r} in\n{out}"
+
+
+def test_the_pytest_plugin_loads_light_and_runs_scripts(installed: Installed) -> None:
+    (installed.work / "test_plain.py").write_text(PLUGIN_MODULES_CHECK, encoding="utf-8")
+    out = must("pytest on a plain test", [installed.python, "-m", "pytest", "-s", "-p", "no:cacheprovider",
+                                          "test_plain.py"], installed.work, installed.env)
+    loaded = next((line.split("LOADED", 1)[1].split() for line in out.splitlines() if "LOADED" in line), None)
+    assert loaded is not None, f"pytest on a plain test printed no LOADED line:\n{out}"
+    assert "liansuo.proving.pytest_plugin" in loaded, f"the pytest11 entry point did not load the plugin: {loaded}"
+    heavy = set(loaded) - {"liansuo", "liansuo.proving", "liansuo.proving.pytest_plugin"}
+    top = sorted({".".join(m.split(".")[:2]) if m.startswith("liansuo.") else m.split(".")[0] for m in heavy})
+    assert not heavy, f"a pytest run that collects no script imports {top} ({len(heavy)} modules)"
+    (installed.work / "test_routes.yaml").write_text(ROUTE_SCRIPT, encoding="utf-8")
+    out = must("pytest on a route-test script", [installed.python, "-m", "pytest", "-p", "no:cacheprovider",
+                                                 "test_routes.yaml"], installed.work, installed.env)
+    assert "2 passed" in out.strip().splitlines()[-1], f"pytest test_routes.yaml:\n{out}"
