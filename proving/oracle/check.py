@@ -20,7 +20,7 @@ from __future__ import annotations
 from collections.abc import Iterable
 from dataclasses import dataclass
 
-from liansuo.interlocking.rules import RuleSet
+from liansuo.rules import RuleSet
 from liansuo.stations.schema import SectionRole, SignalKind
 from liansuo.stations.station import Station
 

@@ -12,7 +12,7 @@ import shlex
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-from liansuo.interlocking.rules import RuleSet
+from liansuo.rules import RuleSet
 
 from .check import Finding, Oracle
 
