@@ -115,6 +115,8 @@ class Aspects(BaseModel):
         for role in ("stop", "shunt_stop"):
             if self.rank.get(getattr(self, role), 0) != 0:
                 out.append(((role,), f"the {role.replace('_', ' ')} aspect must rank 0"))
+        if all(name in self.flashing for name in self.diverging):
+            out.append((("diverging",), "a diverging route needs a steady aspect: list one that does not flash"))
         for name in self.flashing:
             if self.flasher_lamp not in self.lamps.get(name, [self.flasher_lamp]):
                 out.append((("flasher_lamp",), f"flashing aspect '{name}' does not light '{self.flasher_lamp}'"))

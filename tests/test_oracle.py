@@ -206,7 +206,7 @@ def test_guided_movements_under_guide_total_lock_are_the_operators_to_answer_for
 
 # ---- the rules, stated on their own ----------------------------------------------------------------------------------
 def test_aspects_are_read_by_colour_from_the_lamps_lit() -> None:
-    reader = LampReader(load_rules().lamps)
+    reader = LampReader(load_rules().aspects)
     assert reader.read(frozenset({"U", "U2"})) == "UU"
     assert reader.read(frozenset({"U", "U2"}), flashing=True) == "USU"
     assert reader.read(frozenset({"U2"})) == "U"  # one yellow, whichever lamp
@@ -221,7 +221,7 @@ def test_aspects_are_read_by_colour_from_the_lamps_lit() -> None:
     ("UU", "LU", False), ("USU", "UU", True), ("USU", "LU", False), ("H", "U", False),
 ])
 def test_an_aspect_never_more_permissive_than_its_path(limit: str, shown: str, ok: bool) -> None:
-    assert permits(limit, shown) is ok
+    assert permits(limit, shown, load_rules().aspects) is ok
 
 
 def test_the_oracle_reads_the_station_not_the_table() -> None:
