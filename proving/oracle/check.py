@@ -71,7 +71,7 @@ class _Held(Extent):
 class Oracle:
     def __init__(self, station: Station, rules: RuleSet, *, cycle_s: float = 0.25, reaction: int = 2) -> None:
         self.st = station
-        self.tracer = Tracer(station)
+        self.tracer = Tracer(station, overlap_release_s=rules.overlap_release_s)
         self.flank = Flank(station)
         self.aspects = rules.aspects
         self.reader = LampReader(rules.aspects)
