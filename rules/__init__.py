@@ -61,9 +61,9 @@ def bundled() -> list[str]:
     return sorted(p.name for p in BUNDLED.iterdir() if (p / "interlocking.yaml").is_file())
 
 
-def _folder(name: str | Path) -> Path:
-    if str(name) in bundled():
-        return BUNDLED / str(name)
+def _folder(name: str) -> Path:
+    if name in bundled():
+        return BUNDLED / name
     path = Path(name)
     if path.is_dir():
         return path
@@ -83,11 +83,15 @@ def _part(model: type[BaseModel], rf: RuleFile, problems: list[Problem]) -> Base
     return part
 
 
-@cache
 def load_rules(name: str | Path = DEFAULT) -> RuleSet:
-    """The rule set called ``name`` (a bundled one, see :func:`bundled`) or held in the folder ``name``.
+    """The rule set called ``name`` (a bundled one, see :func:`bundled`) or held in the folder ``name``, read once.
 
     Raises :class:`RuleError` naming file, line and what is wrong for every problem found in any of its files."""
+    return _load(str(name))
+
+
+@cache
+def _load(name: str) -> RuleSet:
     folder = _folder(name)
     problems: list[Problem] = []
     files_read: dict[str, RuleFile] = {}
