@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from .equipment import equipment
+from liansuo.rules import DoorSpec, load_rules
 
 
 @dataclass
@@ -29,6 +29,7 @@ class PlatformDoors:
     opening: float = 0.0  # 0 closed and locked, 1 fully open
     moving: int = 0  # +1 opening, -1 closing, 0 still
     faults: DoorFaults = field(default_factory=DoorFaults)
+    spec: DoorSpec = field(default_factory=lambda: load_rules().equipment.doors)  # opening and closing times
 
     @property
     def pdkj(self) -> bool:
@@ -53,7 +54,7 @@ class PlatformDoors:
         """Advance the doors; True when PDKJ may have changed."""
         if self.moving == 0:
             return False
-        spec = equipment().doors
+        spec = self.spec
         before = self.pdkj
         if self.moving > 0:
             self.opening = min(1.0, self.opening + dt / spec.open_s)

@@ -13,6 +13,7 @@ from __future__ import annotations
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 
+from liansuo.rules import RuleSet, load_rules
 from liansuo.stations.station import Station
 
 from .doors import PlatformDoors
@@ -45,19 +46,23 @@ class Changes:
 
 
 class Field:
-    def __init__(self, station: Station, *, flasher: str = "auto") -> None:
+    def __init__(self, station: Station, *, flasher: str = "auto", rules: RuleSet | None = None) -> None:
+        """``rules``: the rule set whose equipment figures and flashing lamp the field has (default: the default)."""
         self.station = station
+        rules = rules or load_rules()
+        self.flasher_lamp = rules.aspects.flasher_lamp
         self.geometry = RailGeometry(station)
         self.circuits: dict[str, SectionCircuit] = {
             s: build_circuit(station, s, self.geometry.section_length[s]) for s in station.sections}
-        self.machines = {t.id: SwitchMachine(t.id, t.machine.value) for t in station.model.turnouts}
+        self.machines = {t.id: SwitchMachine(t.id, t.machine.value, equipment=rules.equipment)
+                         for t in station.model.turnouts}
         self.lamps = {s.id: SignalLamps([lamp.value for lamp in s.lamps]) for s in station.model.signals}
         self.flashers: dict[str, RelayFlasher | ElectronicFlasher] = {}
         for s in station.model.signals:
             if s.usu:
                 kind = s.flasher if flasher == "auto" else flasher
                 self.flashers[s.id] = RelayFlasher() if kind == "relay" else ElectronicFlasher()
-        self.doors = {f"{p.id}:{d.side.value}": PlatformDoors(f"{p.id}:{d.side.value}")
+        self.doors = {f"{p.id}:{d.side.value}": PlatformDoors(f"{p.id}:{d.side.value}", spec=rules.equipment.doors)
                       for p in station.model.platforms for d in p.screen_doors}
         self.faults: dict[tuple[str, str], Fault] = {}
         self.axles: list[Axle] = []
@@ -202,9 +207,9 @@ class Field:
         lit = set(self.lamps[signal].lit())
         fl = self.flashers.get(signal)
         if fl is not None and fl.energised:
-            lit.discard("U")
+            lit.discard(self.flasher_lamp)
             if fl.lamp_lit:
-                lit.add("U")
+                lit.add(self.flasher_lamp)
         return lit
 
     # ---- faults -------------------------------------------------------------------------------------------------

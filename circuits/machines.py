@@ -19,7 +19,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from .equipment import MachineSpec, equipment
+from liansuo.rules import Equipment, MachineSpec, load_rules
 
 
 @dataclass
@@ -36,10 +36,15 @@ class MachineFaults:
 
 
 class SwitchMachine:
-    def __init__(self, turnout: str, machine: str, position: str = "normal") -> None:
+    def __init__(self, turnout: str, machine: str, position: str = "normal", *,
+                 equipment: Equipment | None = None) -> None:
         self.turnout = turnout
         self.type = machine
-        self.spec: MachineSpec = equipment().machines[machine]
+        self.equipment = equipment or load_rules().equipment
+        if machine not in self.equipment.machines:
+            raise ValueError(f"turnout {turnout}: the rule set has no figures for switch machine {machine} (its "
+                             f"equipment.yaml knows {', '.join(self.equipment.machines)})")
+        self.spec: MachineSpec = self.equipment.machines[machine]
         self.rails: str | None = position  # where the switch rails lie (None: between positions)
         self.locked = True
         self.target: str | None = None
@@ -60,7 +65,7 @@ class SwitchMachine:
         f = self.faults
         if f.no_indication or f.squeezed or not self.locked or self.rails != position:
             return False
-        return f.obstruction_mm < equipment().obstruction_lock_mm
+        return f.obstruction_mm < self.equipment.obstruction_lock_mm
 
     @property
     def resistance_N(self) -> float:
@@ -101,7 +106,7 @@ class SwitchMachine:
         self.running = False
         self.target = None
         # the lock closes only if nothing holds the switch rail off the stock rail
-        self.locked = self.faults.obstruction_mm < equipment().obstruction_lock_mm
+        self.locked = self.faults.obstruction_mm < self.equipment.obstruction_lock_mm
         return True
 
     def trail(self, position: str) -> None:
@@ -113,4 +118,4 @@ class SwitchMachine:
 
     def repair_squeeze(self) -> None:
         self.faults.squeezed = False
-        self.locked = self.rails is not None and self.faults.obstruction_mm < equipment().obstruction_lock_mm
+        self.locked = self.rails is not None and self.faults.obstruction_mm < self.equipment.obstruction_lock_mm

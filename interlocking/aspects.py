@@ -2,7 +2,8 @@
 
 Codes: L green, LL two greens, LU green-yellow, U yellow, UU two yellows, USU flashing yellow over yellow,
 H red, HB red + moon-white (guide), B moon-white (shunting proceed), A blue (shunting stop).
-Nothing outside this module and ``rules/china.yaml`` knows these rules by name.
+Nothing outside this module and the rule set's data (``rules/china/``) knows these aspects by their codes: the rest
+of the code names them by role from the rule set (``rules.aspects.stop``, ``.guide``, ``.shunt`` ...).
 """
 
 from __future__ import annotations
@@ -19,21 +20,29 @@ if TYPE_CHECKING:
 
     from .route import Route, RouteTurnout
 
-PROCEED_TRAIN = ("L", "LL", "LU", "U", "UU", "USU")
 STOP = ("H", "A")
-# most permissive first; used to compare aspects
-ORDER = {"L": 6, "LL": 6, "USU": 5, "LU": 5, "UU": 4, "U": 3, "HB": 2, "B": 2, "H": 0, "A": 0, "": 0}
+TRAIN_STOP = "H"
+# An automatic block signal whose sections are clear, by the aspect of the signal ahead (anything else, or no signal
+# ahead: L). A guide aspect (HB) ahead shows its red lamp: prepare to stop.
+_BLOCK_FOLLOW = {"H": "U", "A": "U", "": "U", "HB": "U", "U": "LU", "UU": "U"}
 
 
 def is_open(aspect: str) -> bool:
     return aspect not in STOP and aspect != ""
 
 
-GUIDE_ASPECT = "HB"  # 引导信号: red and moon-white
-
-
 def stop_aspect(station: Station, signal: str) -> str:
     return "A" if station.signals[signal].kind is SignalKind.shunting else "H"
+
+
+def block_aspect(ahead: str | None) -> str:
+    """The aspect of an automatic block signal with its sections clear, by the aspect ``ahead`` (None: no signal)."""
+    return "L" if ahead is None else _BLOCK_FOLLOW.get(ahead, "L")
+
+
+def at_stop_or_dark(aspect: str | None) -> bool:
+    """A train signal at stop, or dark: with its red lamp out, the block signal in rear shows stop (红灯转移)."""
+    return aspect in (TRAIN_STOP, "")
 
 
 def usu_allowed(station: Station, route: Route, rules: RuleSet) -> bool:

@@ -8,12 +8,10 @@ from collections.abc import Callable, Collection, Iterable
 from liansuo.stations.schema import SignalKind
 from liansuo.stations.station import Station
 
+from .aspects import TRAIN_STOP, at_stop_or_dark, block_aspect
 from .io import Outputs
 from .rules import RuleSet
 from .state import RouteStage, RouteState
-
-# aspect ahead -> this signal; anything else -> L. A guide aspect (HB) ahead shows its red lamp: prepare to stop.
-_FOLLOW = {"H": "U", "A": "U", "": "U", "HB": "U", "U": "LU", "UU": "U"}
 
 
 class AutoBlock:
@@ -57,13 +55,13 @@ class AutoBlock:
         for _ in range(len(self.signals) + 1):
             changed = False
             for sig, sections, nxt in self.signals:
-                ahead = out.signals.get(nxt, "L") if nxt else "L"
+                ahead = out.signals.get(nxt) if nxt else None
                 if self.line.get(sig) in reversed_lines or any(not clear(s) for s in sections) or (
-                        nxt in red_dark and ahead in ("H", "")):
-                    aspect = "H"
+                        nxt in red_dark and at_stop_or_dark(ahead)):
+                    aspect = TRAIN_STOP
                 else:
-                    aspect = _FOLLOW.get(ahead, "L")
-                shown = proven(sig, aspect) if aspect != "H" else "H"
+                    aspect = block_aspect(ahead)
+                shown = proven(sig, aspect) if aspect != TRAIN_STOP else TRAIN_STOP
                 if out.signals.get(sig) != shown:
                     out.set_aspect(sig, shown)
                     changed = True
@@ -80,7 +78,7 @@ def cab_codes(station: Station, rules: RuleSet, routes: Iterable[RouteState],
         if r.kind != "train" or rs.stage not in (RouteStage.open, RouteStage.guide, RouteStage.in_use):
             continue
         governing = r.end_signal if r.end_signal else r.signal
-        code = rules.cab_codes.get(aspects.get(governing, "H"))
+        code = rules.aspects.cab_codes.get(aspects.get(governing, rules.aspects.stop))
         for i, s in enumerate(rs.sections):
             if s in codes and not rs.released[i]:
                 codes[s] = code

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from liansuo.stations.schema import SectionRole
 from liansuo.stations.station import Station
 
-from .aspects import GUIDE_ASPECT, downgrade, is_open, onward_allows_usu, select_aspect, stop_aspect
+from .aspects import downgrade, is_open, onward_allows_usu, select_aspect, stop_aspect
 from .autoblock import AutoBlock, cab_codes
 from .block64d import BlockLink, line_pulses_in, line_tracks_changed
 from .io import Alarm, DoorCommand, Event, Outputs, RelayBoard
@@ -286,11 +286,11 @@ class Core:
         blocker = self.liaison_blocker(r)
         if blocker:
             return blocker
-        aspect = self.wanted_aspect(rs) if not guide else GUIDE_ASPECT
+        aspect = self.wanted_aspect(rs) if not guide else self.rules.aspects.guide
         if not is_open(aspect):
             return self._why_closed(rs)
         shown = self.proven(r.signal, aspect)
-        if not is_open(shown) or (guide and shown != GUIDE_ASPECT):
+        if not is_open(shown) or (guide and shown != self.rules.aspects.guide):
             return f"a lamp of signal {r.signal} for {aspect} is dark"
         return ""
 
@@ -371,11 +371,13 @@ class Core:
         return out
 
     def _clear_blocks(self, link: str) -> int:
+        """Clear block sections ahead of a departure, as many as the automatic block's aspects can tell apart."""
         sections = self.auto_links[link]
+        most = len(self.rules.aspects.automatic_block) - 1
         if link in self.line_out:  # worked against its running direction: the whole line is one block
-            return 3 if all(self.clear(s) for s in sections) else 0
+            return most if all(self.clear(s) for s in sections) else 0
         n = 0
-        for s in sections[:3]:
+        for s in sections[:most]:
             if not self.clear(s):
                 break
             n += 1
@@ -404,7 +406,7 @@ class Core:
     def proven(self, signal: str, aspect: str) -> str:
         """The aspect after lamp proving: never more permissive than ``aspect``."""
         dark = {lamp for lamp in self.rules.lamps.get(aspect, []) if not self.board.lamp_ok(signal, lamp)}
-        if aspect == "USU" and not self.board.flasher_ok(signal):
+        if aspect in self.rules.aspects.flashing and not self.board.flasher_ok(signal):
             dark.add("flasher")
         if not dark:
             return aspect

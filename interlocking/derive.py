@@ -338,7 +338,7 @@ class _Builder:
             exit_link=exit_link, line_sections=line,
             overlap_sections=tuple(ov.sections) if ov else (),
             overlap_turnouts=tuple(RouteTurnout(t.turnout, t.position, "route") for t in ov.turnouts) if ov else (),
-            overlap_release_s=float(ov.release_s) if ov else 0.0,
+            overlap_release_s=(self.rules.overlap_release_s if ov.release_s is None else ov.release_s) if ov else 0.0,
             diamonds=diamonds, leads_into=leads_into, run_on=run_on,
         )
 

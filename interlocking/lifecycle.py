@@ -18,7 +18,7 @@ what a signal needs to open is the core's (:meth:`~.core.Core.open_blocker`).
 
 from __future__ import annotations
 
-from .aspects import GUIDE_ASPECT, is_open, stop_aspect
+from .aspects import is_open, stop_aspect
 from .core import Core
 from .locks import Hold
 from .route import RunOn
@@ -260,9 +260,10 @@ class RouteLifecycle:
         rs.since = il.now
         il.clear_alarm(f"closed:{signal}")
         il.signals[signal].route = rs.id
-        il.out.set_aspect(signal, GUIDE_ASPECT)
+        guide = il.rules.aspects.guide
+        il.out.set_aspect(signal, guide)
         il.codes_dirty = True
-        il.event("signal", f"guide aspect {GUIDE_ASPECT} on {signal} (route {rs.id})")
+        il.event("signal", f"guide aspect {guide} on {signal} (route {rs.id})")
 
     def close_signal(self, rs: RouteState, reason: str, *, abnormal: bool) -> None:
         """Show the stop aspect. ``abnormal``: a condition was lost (-> closed, with an alarm); otherwise the caller
@@ -339,8 +340,9 @@ class RouteLifecycle:
     def open_guide_only(self, signal: str) -> None:
         il = self.il
         il.guide_only[signal] = GuideOnly(il.now)
-        il.out.set_aspect(signal, GUIDE_ASPECT)
-        il.event("signal", f"guide aspect {GUIDE_ASPECT} on {signal} under guide total lock")
+        guide = il.rules.aspects.guide
+        il.out.set_aspect(signal, guide)
+        il.event("signal", f"guide aspect {guide} on {signal} under guide total lock")
 
     def close_guide_only(self, signal: str, alarm: str = "") -> None:
         il = self.il

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from liansuo.stations.schema import Button, SignalKind
 
-from .aspects import GUIDE_ASPECT, stop_aspect
+from .aspects import stop_aspect
 from .core import INTERLOCKED, Core
 from .io import Result
 from .lifecycle import RouteLifecycle
@@ -273,7 +273,9 @@ class Operator:
         if signal not in st.signals:
             return Result.refuse(f"there is no signal '{signal}' at {st.id}")
         sig = st.signals[signal]
-        if sig.kind not in (SignalKind.home, SignalKind.route) or "B" not in [lamp.value for lamp in sig.lamps]:
+        guide = self.il.rules.aspects.guide
+        if sig.kind not in (SignalKind.home, SignalKind.route) or not self.il.rules.aspects.can_show(
+                guide, [lamp.value for lamp in sig.lamps]):
             return Result.refuse(f"signal {signal} has no guide aspect: only home and route signals with a "
                                  "moon-white lamp show HB")
         if not self.il.board.lamp_ok(signal, stop_aspect(st, signal)):
@@ -291,7 +293,7 @@ class Operator:
             if blocker.startswith(("turnout", "block", "screen", "line")):
                 return Result.refuse(f"guide refused: {blocker}")
             self.lifecycle.open_guide(rs)
-            return Result.accept(f"guide aspect {GUIDE_ASPECT} on {signal}")
+            return Result.accept(f"guide aspect {guide} on {signal}")
         throat = next((name for name, turnouts in self.il.table.throats.items()
                        if name == signal and all(self._guide_locked(t, name) for t in turnouts)), None)
         if throat is None:
@@ -301,7 +303,7 @@ class Operator:
         if doors:  # the way is not known: every platform track the signal leads to must have its doors safe
             return Result.refuse(f"guide refused: {doors}")
         self.lifecycle.open_guide_only(signal)
-        return Result.accept(f"guide aspect {GUIDE_ASPECT} on {signal} (guide total lock)")
+        return Result.accept(f"guide aspect {guide} on {signal} (guide total lock)")
 
     def _guide_locked(self, turnout: str, throat: str) -> bool:
         return any(lk.hold is Hold.guide and lk.holder == throat for lk, _, _ in self.il.locks.turnout_locks(turnout))

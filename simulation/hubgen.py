@@ -30,6 +30,13 @@ from typing import Any
 
 import yaml
 
+from liansuo.stations.schema import Lamp
+
+# the lamps of the generated signals, as the station file lists them
+SHUNTING_LAMPS = (Lamp.A.value, Lamp.B.value)
+HOME_LAMPS = (Lamp.U.value, Lamp.L.value, Lamp.H.value, Lamp.U2.value, Lamp.B.value)
+STARTING_LAMPS = (Lamp.L.value, Lamp.H.value, Lamp.B.value)
+
 # layout in metres, measured from the boundary into the station ("u"); the S end is the mirror image
 _HOME_U = 300.0  # home signal joint
 _XOVER_START_U = 360.0  # first crossover turnout
@@ -119,7 +126,7 @@ class _Builder:
         n = self.next_shunt[end]
         self.next_shunt[end] += 2
         self.signals.append({"id": f"D{n}", "kind": "shunting", "at": at, "direction": direction,
-                             "lamps": ["A", "B"], "buttons": ["shunt"]})
+                             "lamps": list(SHUNTING_LAMPS), "buttons": ["shunt"]})
 
     # ---- one throat ------------------------------------------------------------------------------------------
     def throat(self, end: str) -> None:
@@ -151,7 +158,7 @@ class _Builder:
             self.sections.append({"id": approach, "type": "25hz", "role": "approach"})
             self.track(bnd, home, approach, row)
             self.signals.append({"id": f"{end}J{g}", "kind": "home", "at": home, "direction": into,
-                                 "lamps": ["U", "L", "H", "U2", "B"], "buttons": ["train"]})
+                                 "lamps": list(HOME_LAMPS), "buttons": ["train"]})
             lead.nodes.append((home, None, None))
             for _, tid, low, high in sorted(lead_turnouts[g]):
                 lead.nodes.append((tid, low, high))
@@ -189,10 +196,10 @@ class _Builder:
                 n = first + i
                 if end == "X":
                     self.signals.append({"id": f"S{n}", "kind": "starting", "at": jid, "direction": "up",
-                                         "lamps": ["L", "H", "B"], "buttons": ["train", "shunt"]})
+                                         "lamps": list(STARTING_LAMPS), "buttons": ["train", "shunt"]})
                 else:
                     self.signals.append({"id": f"X{n}", "kind": "starting", "at": jid, "direction": "down",
-                                         "lamps": ["L", "H", "B"], "buttons": ["train", "shunt"]})
+                                         "lamps": list(STARTING_LAMPS), "buttons": ["train", "shunt"]})
 
     def lay_lead(self, end: str, g: int, lead: _Lead, row: float) -> None:
         nodes = lead.nodes

@@ -15,8 +15,8 @@ from liansuo.circuits.railgeometry import Axle
 from liansuo.interlocking.cbi import Interlocking
 from liansuo.interlocking.io import Event, Result
 from liansuo.interlocking.locks import Hold
-from liansuo.interlocking.rules import RuleSet, load_rules
 from liansuo.interlocking.table import InterlockingTable, build_table
+from liansuo.rules import RuleSet, load_rules
 from liansuo.stations.loader import load
 from liansuo.stations.station import Station
 
@@ -45,12 +45,12 @@ class Simulation:
                  table: InterlockingTable | None = None, engine: str | MotionEngine = "kinematic") -> None:
         """``engine``: what moves the trains, "kinematic" (built in, the default) or "sumo" (Eclipse SUMO, the
         ``sumo`` extra; see docs/sumo.md), or a :class:`~simulation.trains.engine.MotionEngine`."""
-        self.station = station if isinstance(station, Station) else load(station)
-        self.rules = load_rules(rules) if isinstance(rules, str) else rules
+        self.rules = load_rules(rules) if isinstance(rules, str) else rules  # one name chooses every part
+        self.station = station if isinstance(station, Station) else load(station, rules=self.rules)
         self.table = table or build_table(self.station, self.rules)
         self.cycle_s = cycle_s
         self.interlocking: Interlocking = Interlocking(self.table, self.rules, cycle_s)
-        self.field: Field = Field(self.station)
+        self.field: Field = Field(self.station, rules=self.rules)
         self.wiring = Wiring(self.station, self.rules, self.field)
         self.neighbours = Neighbours(self.station, self.rules.block_pulse_s)
         self.t = 0.0
@@ -60,7 +60,7 @@ class Simulation:
         self.alarms: dict[str, str] = {}  # the world's alarms (derailment, squeeze by a train)
         motion = make_engine(engine, self.station, cycle_s)
         self.fleet = Fleet(self.station, self.field, lambda: self.interlocking.out.signals, self.log,
-                           self._auto_limit, engine=motion)
+                           self._auto_limit, engine=motion, rules=self.rules)
         attach_engine(motion, self.fleet)
         self.wiring.publish(self.interlocking.board, everything=True)
         self.interlocking.cycle(self.t)

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from liansuo.circuits.field import Field, FieldCommands
 from liansuo.interlocking.io import Outputs, RelayBoard
-from liansuo.interlocking.rules import RuleSet
+from liansuo.rules import RuleSet
 from liansuo.stations.station import Station
 
 
@@ -33,7 +33,7 @@ class Wiring:
         for sig in changed:
             aspect = out.signals.get(sig, "")
             cmd.lamps[sig] = set(self.rules.lamps.get(aspect, [])) & self.signal_lamps[sig]
-            if aspect == "USU":
+            if aspect in self.rules.aspects.flashing:
                 cmd.flashing.add(sig)
             else:
                 cmd.flashing.discard(sig)

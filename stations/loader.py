@@ -12,6 +12,8 @@ from typing import Any
 
 from pydantic import ValidationError
 
+from liansuo.rules import RuleSet
+
 from .checks import cross_check
 from .library import resolve
 from .rules import design_warnings
@@ -73,7 +75,7 @@ def _schema_diagnostics(src: Source, exc: ValidationError) -> list[Diagnostic]:
     return out
 
 
-def parse_source(src: Source) -> Station:
+def parse_source(src: Source, rules: RuleSet | None = None) -> Station:
     if not isinstance(src.data, dict):
         raise StationError([src.diagnostic((), "a station file is a mapping of keys such as 'id:' and 'tracks:'",
                                            "see docs/station-format.md for a small complete example")])
@@ -86,15 +88,16 @@ def parse_source(src: Source) -> Station:
     if errors:
         raise StationError(errors)
     station = Station(model, src)
-    station.warnings = design_warnings(station)
+    station.warnings = design_warnings(station, rules.design if rules else None)
     return station
 
 
-def load_text(text: str, file: str = "<station>") -> Station:
-    return parse_source(read_yaml(text, file))
+def load_text(text: str, file: str = "<station>", *, rules: RuleSet | None = None) -> Station:
+    return parse_source(read_yaml(text, file), rules)
 
 
-def load(name_or_path: str | Path) -> Station:
-    """Load a bundled station by name (``jiaopei``) or any station file by path."""
+def load(name_or_path: str | Path, *, rules: RuleSet | None = None) -> Station:
+    """Load a bundled station by name (``jiaopei``) or any station file by path; its design warnings follow the
+    design rules of ``rules`` (by default the default rule set)."""
     path = resolve(name_or_path)
-    return parse_source(read_file(path))
+    return parse_source(read_file(path), rules)

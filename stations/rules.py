@@ -1,48 +1,22 @@
 """Station-design rules (joint stagger, dead-zone spacing, fouling clearance, coding length, carriers) as warnings.
 
-The numbers come from ``design_rules.yaml``; each warning states the measured figure and the limit.
+The numbers come from the rule set (``rules/NAME/design.yaml``); each warning states the measured figure and the limit.
 """
 
 from __future__ import annotations
 
-from functools import cache
-from importlib.resources import files
 from itertools import pairwise
 
-import yaml
-from pydantic import BaseModel, ConfigDict
+from liansuo.rules import DesignRules, load_rules
 
 from .schema import CircuitType, Direction, JointKind, SignalKind
 from .source import Diagnostic, Loc
 from .station import Station
 
 
-class DesignRules(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
-
-    joint_stagger_max_m: float
-    joint_stagger_max_turnout_m: float
-    dead_zone_spacing_min_m: float
-    dead_zone_spacing_relaxed_m: float
-    dead_zone_short_m: float
-    fouling_clearance_m: float
-    fouling_clearance_emu_m: float
-    cab_code_min_time_s: float
-    cab_code_margin_m: float
-    coding_speed_kmh: float
-    tuning_area_m: float
-    tuning_area_tolerance_m: float
-    tuning_dead_zone_max_m: float
-    capacitor_min_section_m: float
-    capacitor_spacing_m: float
-    phase25hz_max_length_m: float
-    bogie_wheelbase_min_m: float
-
-
-@cache
 def design_rules() -> DesignRules:
-    data = yaml.safe_load((files("liansuo.stations") / "design_rules.yaml").read_text(encoding="utf-8"))
-    return DesignRules.model_validate(data)
+    """The design rules of the default rule set."""
+    return load_rules().design
 
 
 def min_coded_length(speed_kmh: float, rules: DesignRules | None = None) -> float:
@@ -56,9 +30,9 @@ def _index(items: list[object], ident: str) -> int:
 
 
 class _Warner:
-    def __init__(self, station: Station) -> None:
+    def __init__(self, station: Station, rules: DesignRules | None = None) -> None:
         self.st = station
-        self.r = design_rules()
+        self.r = rules or design_rules()
         self.out: list[Diagnostic] = []
 
     def warn(self, loc: Loc, message: str, hint: str = "") -> None:
@@ -185,5 +159,6 @@ class _Warner:
                           "add 'capacitors: {rule: standard}'")
 
 
-def design_warnings(station: Station) -> list[Diagnostic]:
-    return _Warner(station).run()
+def design_warnings(station: Station, rules: DesignRules | None = None) -> list[Diagnostic]:
+    """The station against the design rules (by default those of the default rule set)."""
+    return _Warner(station, rules).run()

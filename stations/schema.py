@@ -375,12 +375,12 @@ class TurnoutAt(Strict):
 class Overlap(Strict):
     """An overlap (延续进路) beyond the end signal of receiving routes, where the file asks for one (e.g. a falling
     gradient over 6 per mille beyond the track): its sections and turnouts are locked with the route and released
-    ``release_s`` after the train occupies the receiving track."""
+    ``release_s`` after the train occupies the receiving track (by default the rule set's ``overlap_release_s``)."""
 
     end_signal: Id
     sections: list[Id] = Field(min_length=1)
     turnouts: list[TurnoutAt] = Field(default_factory=list)
-    release_s: Annotated[float, Field(gt=0)] = 180.0
+    release_s: Annotated[float, Field(gt=0)] | None = None
 
 
 class StationFile(Strict):

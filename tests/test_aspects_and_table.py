@@ -10,7 +10,7 @@ from conftest import Driver
 from hypothesis import given
 from hypothesis import strategies as st
 
-from liansuo.interlocking.aspects import ORDER, downgrade
+from liansuo.interlocking.aspects import downgrade
 from liansuo.interlocking.rules import load_rules
 from liansuo.interlocking.table import build_table
 from liansuo.simulation.cli import main
@@ -24,7 +24,7 @@ ALL_LAMPS = ["L", "L2", "U", "U2", "H", "B", "A", "flasher"]
 
 @given(st.sampled_from(sorted(RULES.downgrade)), st.sets(st.sampled_from(ALL_LAMPS)))
 def test_a_dark_lamp_never_makes_an_aspect_more_permissive(aspect: str, dark: set[str]) -> None:
-    assert ORDER[downgrade(aspect, dark, RULES)] <= ORDER[aspect]
+    assert RULES.aspects.rank_of(downgrade(aspect, dark, RULES)) <= RULES.aspects.rank_of(aspect)
 
 
 @pytest.mark.parametrize(("aspect", "dark", "shown"), [

@@ -1,6 +1,6 @@
-"""The independent safety oracle: it imports nothing of the interlocking but rule data; random operation of the
-stations keeps every property; it catches an interlocking broken on purpose with the property that breaks; what the
-interlocking cannot see by design is a hazard, not a violation."""
+"""The independent safety oracle: it imports nothing of the interlocking, and of the rules only their data; random
+operation of the stations keeps every property; it catches an interlocking broken on purpose with the property that
+breaks; what the interlocking cannot see by design is a hazard, not a violation."""
 
 from __future__ import annotations
 
@@ -13,12 +13,12 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from liansuo.interlocking.rules import load_rules
 from liansuo.proving.mutants import MUTANTS
 from liansuo.proving.oracle import Watch
 from liansuo.proving.oracle.ceiling import permits
 from liansuo.proving.oracle.lamps import DARK, UNDEFINED, LampReader
 from liansuo.proving.soak import StepGenerator
+from liansuo.rules import load_rules
 from liansuo.simulation.sim import Simulation
 from liansuo.stations.loader import load
 
@@ -49,18 +49,24 @@ def imported(path: Path) -> set[str]:
     return out
 
 
-def test_the_oracle_imports_nothing_of_the_interlocking_but_its_rule_data() -> None:
-    """Neither the table, nor the route engine, nor the aspect rules: the oracle's judgment is its own."""
+def test_the_oracle_imports_nothing_of_the_interlocking_and_of_the_rules_only_their_data() -> None:
+    """Neither the table, nor the route engine, nor the aspect rules: the oracle's judgment is its own. Of the
+    national rules it reads the rule set's data (``liansuo.rules``), which holds no rule code and imports no layer."""
     files = sorted(ORACLE.glob("*.py"))
     assert len(files) >= 8  # the check reads the oracle where it is
     seen: set[str] = set()
     for path in files:
         for module in imported(path):
             seen.add(module)
-            if module.startswith("liansuo.interlocking"):
-                assert module == "liansuo.interlocking.rules", f"{path.name} imports {module}"
+            assert not module.startswith("liansuo.interlocking"), f"{path.name} imports {module}"
+            if module.startswith("liansuo.rules"):
+                assert module == "liansuo.rules", f"{path.name} imports {module}"
             assert not module.startswith(("liansuo.proving.verify", "liansuo.proving.soak",
                                           "liansuo.proving.mutants")), (path.name, module)
+    assert "liansuo.rules" in seen
+    for path in sorted((ROOT / "liansuo" / "rules").glob("*.py")):
+        below = {m for m in imported(path) if m.startswith("liansuo.") and not m.startswith("liansuo.rules")}
+        assert not below, f"rules/{path.name} imports {below}: the rule set is data, it imports no layer"
     assert "liansuo.stations.station" in seen and "liansuo.proving.oracle.authority" in seen  # imports were read
 
 
@@ -200,7 +206,7 @@ def test_guided_movements_under_guide_total_lock_are_the_operators_to_answer_for
 
 # ---- the rules, stated on their own ----------------------------------------------------------------------------------
 def test_aspects_are_read_by_colour_from_the_lamps_lit() -> None:
-    reader = LampReader(load_rules().lamps)
+    reader = LampReader(load_rules().aspects)
     assert reader.read(frozenset({"U", "U2"})) == "UU"
     assert reader.read(frozenset({"U", "U2"}), flashing=True) == "USU"
     assert reader.read(frozenset({"U2"})) == "U"  # one yellow, whichever lamp
@@ -215,7 +221,7 @@ def test_aspects_are_read_by_colour_from_the_lamps_lit() -> None:
     ("UU", "LU", False), ("USU", "UU", True), ("USU", "LU", False), ("H", "U", False),
 ])
 def test_an_aspect_never_more_permissive_than_its_path(limit: str, shown: str, ok: bool) -> None:
-    assert permits(limit, shown) is ok
+    assert permits(limit, shown, load_rules().aspects) is ok
 
 
 def test_the_oracle_reads_the_station_not_the_table() -> None:

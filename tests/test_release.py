@@ -139,3 +139,14 @@ def test_a_shunting_signal_held_for_its_passing_consist_still_sees_an_occupancy_
     jiaopei("shunt D1 S3", "run 12s", "expect signal D1 B", "occupy QXG", "occupy 7DG", "occupy 1DG", "run 1s",
             "expect signal D1 B")  # the consist entering: approach and the first sections, contiguous
     jiaopei("occupy 5DG", "run 1s", "expect signal D1 A", "expect alarm section 5DG is occupied")
+
+
+def test_an_overlap_without_release_s_releases_after_the_rule_sets_overlap_release_s() -> None:
+    from liansuo.interlocking.table import build_table
+    from liansuo.rules import load_rules
+
+    text = bundled()["jiaopei"].read_text(encoding="utf-8") + OVERLAP.replace(", release_s: 180", "")
+    station = load_text(text, "jiaopei-overlap.yaml")
+    assert build_table(station).routes["X-XI"].overlap_release_s == load_rules().overlap_release_s == 180.0
+    rules = load_rules().model_copy(update={"overlap_release_s": 90.0})
+    assert build_table(station, rules).routes["X-XI"].overlap_release_s == 90.0

@@ -578,7 +578,7 @@ def test_format_doc_explains_every_key() -> None:
 
 def test_format_doc_lists_every_design_rule_and_enum_value() -> None:
     doc = DOC.read_text(encoding="utf-8")
-    rules = ROOT / "stations" / "design_rules.yaml"
+    rules = ROOT / "rules" / "china" / "design.yaml"
     for key, value in yaml.safe_load(rules.read_text(encoding="utf-8")).items():
         assert f"`{key}`" in doc, key
         assert f"{value:g}" in doc, (key, value)

@@ -113,7 +113,7 @@ async def test_a_route_set_by_clicks_opens_and_shows_white_then_cancels_by_funct
         cycles(app, 8)
         assert app.sim.route_state("X-XI") == "open"
         assert band_colour(app, "IG") == BAND_COLOUR["locked"]
-        assert lamp(app, "X") == ("●", LAMP_COLOUR["U"])
+        assert lamp(app, "X") == ("●", LAMP_COLOUR["yellow"])
         assert any(line.split()[1:] == ["trainee>", "route", "X", "XI"] for line in app.log_panel.lines_text)
         await function(pilot, "cancel")
         assert app.function_bar.armed == "cancel"

@@ -204,11 +204,13 @@ class InstructorPanel(VerticalScroll):
 
 
 def default_params(sim: Simulation, kind: str, target: str, params: str = "") -> str:
-    """Parameters a fault needs that have no default: the lamp of a filament fault (the red one if there is)."""
+    """Parameters a fault needs that have no default: the lamp of a filament fault (the red one, the lamp of the stop
+    aspect, if there is)."""
     params = params.strip()
     if kind == "filament" and target in sim.station.signals and "lamp=" not in params:
         lamps = [lamp.value for lamp in sim.station.signals[target].lamps]
-        params = (params + f" lamp={'H' if 'H' in lamps else lamps[0]}").strip()
+        red = sim.rules.aspects.stop_lamp
+        params = (params + f" lamp={red if red in lamps else lamps[0]}").strip()
     return params
 
 

@@ -20,9 +20,8 @@ from .layout import Glyph, Layout, Ref
 if TYPE_CHECKING:
     from liansuo.simulation.sim import Simulation
 
-LAMP_COLOUR = {"L": "#00e050", "L2": "#00e050", "U": "#ffd700", "U2": "#ffd700", "H": "#ff2020", "B": "#f4f4ff",
-               "A": "#2f6bff"}
-LAMP_ORDER = ("H", "L", "U", "B", "A", "L2", "U2")
+# by the lamp's colour (the rule set gives each lamp's colour and their order on the mast)
+LAMP_COLOUR = {"green": "#00e050", "yellow": "#ffd700", "red": "#ff2020", "white": "#f4f4ff", "blue": "#2f6bff"}
 BAND_COLOUR = {"free": "#5b7ea8", "locked": "#ffffff", "occupied": "#ff2a2a"}
 SEVERITY = {"free": 0, "locked": 1, "occupied": 2}
 
@@ -54,7 +53,7 @@ class Frame:
 
     sections: dict[str, str]
     turnouts: dict[str, tuple[str | None, str]]  # position and mark (locked, blocked, guide or '')
-    lamps: dict[str, list[tuple[str, bool]]]  # signal -> [(lamp, lit)] from the joint outwards
+    lamps: dict[str, list[tuple[str, bool]]]  # signal -> [(lamp colour, lit)] from the joint outwards
     countdown: dict[str, int]
     alarmed: set[str]
     doors: dict[str, str]
@@ -70,13 +69,15 @@ def read_frame(sim: Simulation, lay: Layout) -> Frame:
     for t in il.core.turnouts:
         turnouts[t] = (il.board.indication(t), sim.turnout_mark(t))
     lamps: dict[str, list[tuple[str, bool]]] = {}
+    colours = sim.rules.aspects.colours
+    mast = list(colours)  # the rule set lists the lamps in their order on the mast
     for sig in st.model.signals:
         have = [lamp.value for lamp in sig.lamps]
         lit = sim.field.lit_lamps(sig.id)
         aspect = il.out.signals.get(sig.id, "")
         want = [lamp for lamp in sim.rules.lamps.get(aspect, []) if lamp in have]
-        shown = sorted(set(want) | (lit & set(have)), key=lambda x: LAMP_ORDER.index(x) if x in LAMP_ORDER else 9)
-        lamps[sig.id] = [(lamp, lamp in lit) for lamp in shown]
+        shown = sorted(set(want) | (lit & set(have)), key=lambda x: mast.index(x) if x in mast else 9)
+        lamps[sig.id] = [(colours.get(lamp, ""), lamp in lit) for lamp in shown]
     countdown: dict[str, int] = {}
     for rs in il.routes.values():
         if sim.route_state(rs.id) == "time_release" and rs.release_at is not None:
@@ -160,8 +161,8 @@ def glyph(frame: Frame, g: Glyph, pressed: set[Ref]) -> tuple[str, Style]:
         shown = frame.lamps.get(g.ref.id, [])
         if g.slot >= len(shown):
             return " ", S_DIM
-        lamp, lit = shown[g.slot]
-        return ("●", Style(color=LAMP_COLOUR.get(lamp, "white"), bold=True)) if lit else ("○", S_DIM)
+        colour, lit = shown[g.slot]
+        return ("●", Style(color=LAMP_COLOUR.get(colour, "white"), bold=True)) if lit else ("○", S_DIM)
     if role == "signame":
         assert g.ref is not None
         return g.ch, S_NAME_ALARM if g.ref.id in frame.alarmed else S_NAME

@@ -76,8 +76,11 @@ class Authority:
 class Tracer:
     """Traces authorities over one station."""
 
-    def __init__(self, station: Station) -> None:
+    def __init__(self, station: Station, *, overlap_release_s: float = 0.0) -> None:
+        """``overlap_release_s``: the rule set's overlap release time, for an overlap whose station file gives none
+        (only an oracle that times overlaps needs it)."""
         self.st = station
+        self.overlap_release_s = overlap_release_s
         self.topo = station.topology
         self.role = {s: sec.role for s, sec in station.sections.items()}
         self.section_of = {t: tr.section for t, tr in station.tracks.items()}
@@ -135,7 +138,7 @@ class Tracer:
             ov = self.overlaps[a.end_signal]
             a.overlap_sections = tuple(ov.sections)
             a.overlap_turnouts = {t.turnout: t.position.value for t in ov.turnouts}
-            a.overlap_release_s = ov.release_s
+            a.overlap_release_s = ov.release_s if ov.release_s is not None else self.overlap_release_s
         return a
 
     def _add(self, a: Authority, track: str) -> None:

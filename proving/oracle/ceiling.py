@@ -16,21 +16,23 @@ movement is about to run:
   sections ahead, LU with two, U with one; a line worked against its running direction after a direction change
   (改方) is one block: L when all of it is clear;
 - a shunting path allows the moon-white B, whatever lies ahead.
+
+The codes above are those of the Chinese rule set. The code reads every aspect by its role from the rule set's data
+(``aspects.yaml``: ``diverging``, ``rear``, ``automatic_block``, ``rank`` ...), never by its code, and shares none
+of the interlocking's aspect selection.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
+from liansuo.rules import Aspects, RuleSet
 from liansuo.stations.schema import SignalKind
 from liansuo.stations.station import Station
 
 from .authority import Authority
-from .lamps import DARK, RANK, TRAIN_PROCEED, UNDEFINED
+from .lamps import DARK, UNDEFINED
 from .view import FieldView
-
-STOP = "H"
-_GREEN = frozenset({"L", "LL", "LU"})
 
 
 @dataclass(frozen=True)
@@ -39,68 +41,70 @@ class Limit:
     why: str
 
 
-def permits(limit: str, shown: str) -> bool:
+def permits(limit: str, shown: str, aspects: Aspects) -> bool:
     """Is ``shown`` no more permissive than ``limit``? Where the path diverges, only a diverging aspect (or stop, or
     the guide aspect) is allowed: a green or a lone yellow would tell the driver the way is straight."""
     if shown == limit:
         return True
-    if limit in ("USU", "UU") and (shown in _GREEN or shown == "U"):
+    if limit in aspects.diverging and shown in aspects.train_proceed and shown not in aspects.diverging:
         return False
-    return RANK.get(shown, 0) < RANK.get(limit, 0)
+    return aspects.rank_of(shown) < aspects.rank_of(limit)
 
 
-def follow(ahead: str, signal_ahead: str) -> Limit:
+def follow(ahead: str, signal_ahead: str, aspects: Aspects) -> Limit:
     if ahead in (DARK, UNDEFINED):
-        return Limit(STOP, f"signal {signal_ahead} ahead is dark")
-    if ahead in ("L", "LL", "LU", "USU"):
-        return Limit("L", f"{signal_ahead} ahead shows {ahead}")
-    if ahead == "U":
-        return Limit("LU", f"{signal_ahead} ahead shows U")
-    return Limit("U", f"{signal_ahead} ahead shows {ahead}")
+        return Limit(aspects.stop, f"signal {signal_ahead} ahead is dark")
+    most = aspects.rear.get(ahead, aspects.caution)
+    return Limit(most, f"{signal_ahead} ahead shows {ahead}")
 
 
 class Ceiling:
-    def __init__(self, station: Station, usu_min_number: int, semi_auto_departure: str) -> None:
+    def __init__(self, station: Station, rules: RuleSet) -> None:
         self.st = station
-        self.usu_min = usu_min_number
-        self.semi_auto = semi_auto_departure
+        self.a = rules.aspects
+        self.usu_min = rules.usu_min_turnout_number
+        self.semi_auto = rules.aspects.semi_auto_departure
         self.links = {lk.id: lk for lk in station.model.links}
+        # diverging: the steady aspect (two yellows), and the flashing one over No. 18+ turnouts where it may show
+        self.diverging = next(d for d in self.a.diverging if d not in self.a.flashing)
+        self.diverging_flashing = next((d for d in self.a.diverging if d in self.a.flashing), self.diverging)
 
     def of(self, a: Authority, view: FieldView, ahead: str, ahead_path: Authority | None) -> Limit:
         """The ceiling for authority ``a``; ``ahead`` is the aspect its end signal shows (as read from its lamps)
         and ``ahead_path`` that signal's own authority when it is open."""
         if a.kind == "shunt":
-            return Limit("B", "shunting")
+            return Limit(self.a.shunt, "shunting")
         if a.end in ("broken", "loop"):
-            return Limit(STOP, "the path cannot be traced")
+            return Limit(self.a.stop, "the path cannot be traced")
         sig = self.st.signals[a.signal]
         if sig.kind in (SignalKind.home, SignalKind.route):
             reverse = [t for t, pos in a.turnouts.items() if pos == "reverse"]
             if reverse:
                 return self._diverging(a, reverse, ahead, ahead_path)
         if a.end == "signal" and a.end_signal is not None:
-            return follow(ahead, a.end_signal)
+            return follow(ahead, a.end_signal, self.a)
         if a.end == "boundary" and a.link is not None and sig.kind is not SignalKind.block:
             return self._line(a, view)
         if a.end == "buffer":
-            return Limit("U", "the path ends at a buffer stop")
-        return Limit("L", "the path leaves the station model with no block line to judge")
+            return Limit(self.a.caution, "the path ends at a buffer stop")
+        return Limit(self.a.clear, "the path leaves the station model with no block line to judge")
 
     def _diverging(self, a: Authority, reverse: list[str], ahead: str, ahead_path: Authority | None) -> Limit:
+        most, flashing = self.diverging, self.diverging_flashing
         small = [t for t in reverse if self.st.turnouts[t].number < self.usu_min]
         if small:
-            return Limit("UU", f"diverging over turnout {small[0]} (No. {self.st.turnouts[small[0]].number})")
+            return Limit(most, f"diverging over turnout {small[0]} (No. {self.st.turnouts[small[0]].number})")
         if not self.st.signals[a.signal].usu:
-            return Limit("UU", f"diverging; {a.signal} has no flashing yellow")
-        if ahead not in TRAIN_PROCEED or ahead_path is None:
-            return Limit("UU", f"diverging; the next signal {a.end_signal or '-'} is not open")
+            return Limit(most, f"diverging; {a.signal} has no flashing yellow")
+        if ahead not in self.a.train_proceed or ahead_path is None:
+            return Limit(most, f"diverging; the next signal {a.end_signal or '-'} is not open")
         onward = [t for t, pos in ahead_path.turnouts.items()
                   if pos == "reverse" and self.st.turnouts[t].number < self.usu_min]
         if onward:
-            return Limit("UU", f"the next signal {a.end_signal} is open over turnout {onward[0]} reversed "
+            return Limit(most, f"the next signal {a.end_signal} is open over turnout {onward[0]} reversed "
                                f"(No. {self.st.turnouts[onward[0]].number})")
-        return Limit("USU", f"diverging over No. {self.usu_min}+ turnouts, {a.end_signal} open straight or over "
-                            f"No. {self.usu_min}+")
+        return Limit(flashing, f"diverging over No. {self.usu_min}+ turnouts, {a.end_signal} open straight or over "
+                               f"No. {self.usu_min}+")
 
     def _line(self, a: Authority, view: FieldView) -> Limit:
         assert a.link is not None
@@ -108,7 +112,7 @@ class Ceiling:
         if lk.kind.value == "64d":
             if view.line_permits(lk.id):
                 return Limit(self.semi_auto, f"64D line {lk.id} accepted by the neighbour")
-            return Limit(STOP, f"64D line {lk.id} has not been accepted by the neighbour station")
+            return Limit(self.a.stop, f"64D line {lk.id} has not been accepted by the neighbour station")
         clear = 0
         for s in lk.sections:
             if not view.clear(s):
@@ -116,11 +120,13 @@ class Ceiling:
             clear += 1
         if self.st.link_running(lk.id) == "inbound":
             if not view.line_outbound(lk.id):
-                return Limit(STOP, f"line {lk.id} runs towards this station: a departure onto it needs a direction "
-                                   "change (改方)")
+                return Limit(self.a.stop, f"line {lk.id} runs towards this station: a departure onto it needs a "
+                                          "direction change (改方)")
             if clear < len(lk.sections):
-                return Limit(STOP, f"line {lk.id} worked against its running direction is one block, not all clear")
-            return Limit("L", f"line {lk.id} set for departures and clear")
-        aspect = {0: STOP, 1: "U", 2: "LU"}.get(clear, "L")
+                return Limit(self.a.stop, f"line {lk.id} worked against its running direction is one block, not all "
+                                          "clear")
+            return Limit(self.a.clear, f"line {lk.id} set for departures and clear")
+        steps = self.a.automatic_block
+        aspect = steps[min(clear, len(steps) - 1)]
         return Limit(aspect, f"{clear} clear block section(s) on line {lk.id}")
 

@@ -20,14 +20,14 @@ from __future__ import annotations
 from collections.abc import Iterable
 from dataclasses import dataclass
 
-from liansuo.interlocking.rules import RuleSet
+from liansuo.rules import RuleSet
 from liansuo.stations.schema import SectionRole, SignalKind
 from liansuo.stations.station import Station
 
 from .authority import Authority, Tracer
 from .ceiling import Ceiling, permits
 from .flank import Demand, Flank
-from .lamps import UNDEFINED, LampReader, is_proceed
+from .lamps import UNDEFINED, LampReader
 from .meet import Extent, head_on, shared
 from .view import FieldView
 
@@ -71,10 +71,11 @@ class _Held(Extent):
 class Oracle:
     def __init__(self, station: Station, rules: RuleSet, *, cycle_s: float = 0.25, reaction: int = 2) -> None:
         self.st = station
-        self.tracer = Tracer(station)
+        self.tracer = Tracer(station, overlap_release_s=rules.overlap_release_s)
         self.flank = Flank(station)
-        self.reader = LampReader(rules.lamps)
-        self.ceiling = Ceiling(station, rules.usu_min_turnout_number, rules.semi_auto_departure)
+        self.aspects = rules.aspects
+        self.reader = LampReader(rules.aspects)
+        self.ceiling = Ceiling(station, rules)
         self.onto_track = {frozenset(pair) for pair in rules.enemy_onto_track}
         self.cycle_s = cycle_s
         self.reaction = reaction
@@ -166,14 +167,14 @@ class Oracle:
                 found[f"lamps:{sig}"] = Finding(f"lamps:{sig}", "lamps", f"signal {sig} lights "
                                                 f"{'+'.join(sorted(view.lit(sig)))}, which no aspect lights",
                                                 delayed=True)
-            elif is_proceed(aspect):
+            elif self.aspects.is_proceed(aspect):
                 shown[sig] = aspect
         for sig in [s for s in self.shown if s not in shown]:
             a = self.open.pop(sig)
             rear = self.rear[sig]
             entered = rear is None or sig in self.approached or not view.clear(rear)
             if entered and not view.clear(a.sections[0]):
-                self._start_in_use(a, view, sig in self.operated, guided=self.shown[sig] == "HB")
+                self._start_in_use(a, view, sig in self.operated, guided=self.shown[sig] == self.aspects.guide)
             self.operated.discard(sig)
             if self.kind[sig] is not SignalKind.block:
                 self.closed.add(sig)
@@ -185,7 +186,7 @@ class Oracle:
                                                        "command from the operator")
                 self.closed.discard(sig)
                 self.allowed.discard(sig)
-            kind = "shunt" if aspect == "B" else "train"
+            kind = "shunt" if aspect == self.aspects.shunt else "train"
             self.open[sig] = self._trace(sig, kind, view)
         self.shown = shown
         self.approached = {sig for sig in shown if (rear := self.rear[sig]) is not None and not view.clear(rear)}
@@ -199,21 +200,21 @@ class Oracle:
         return self.tracer.trace(sig, kind, view.rails)  # type: ignore[arg-type]
 
     def _repertoire(self, sig: str, aspect: str) -> bool:
-        kind = self.kind[sig]
+        kind, names = self.kind[sig], self.aspects
         if kind is SignalKind.shunting:
-            return aspect == "B"
+            return aspect == names.shunt
         if kind is SignalKind.block:
-            return aspect in ("L", "LU", "U")
-        if aspect == "B":
+            return aspect in names.automatic_block
+        if aspect == names.shunt:
             return kind is SignalKind.starting
-        if aspect in ("HB", "UU", "USU"):
+        if aspect == names.guide or aspect in names.diverging:
             return kind in (SignalKind.home, SignalKind.route)
         return True
 
     # ---- an open authority -------------------------------------------------------------------------------------------
     def _judge_open(self, sig: str, aspect: str, a: Authority, view: FieldView, shown: dict[str, str],
                     found: dict[str, Finding]) -> _Held:
-        guide = aspect == "HB"
+        guide = aspect == self.aspects.guide
         if not self._repertoire(sig, aspect):
             found[f"aspect:{sig}"] = Finding(f"aspect:{sig}", "aspect", f"{self.kind[sig].value} signal {sig} shows "
                                              f"{aspect}, which it never may", delayed=True)
@@ -268,12 +269,12 @@ class Oracle:
         what the relays prove, the interlocking answers for the aspect; what the lamps alone show wrong is a
         hazard it cannot see."""
         limit = self.ceiling.of(a, view, ahead, ahead_path)
-        if permits(limit.aspect, aspect):
+        if permits(limit.aspect, aspect, self.aspects):
             return
         known = self.reader.read(*view.proven_lit(sig))
         ahead_known = self.reader.read(*view.proven_lit(a.end_signal)) if a.end_signal else ahead
         known_limit = self.ceiling.of(a, view, ahead_known, ahead_path) if ahead_known != ahead else limit
-        hidden = permits(known_limit.aspect, known)
+        hidden = permits(known_limit.aspect, known, self.aspects)
         note = ""
         if hidden:
             note = f"; the lamp relays prove {sig} {known}" + (f" and {a.end_signal} {ahead_known}"

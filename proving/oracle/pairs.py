@@ -16,7 +16,7 @@ from __future__ import annotations
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
 
-from liansuo.interlocking.rules import RuleSet
+from liansuo.rules import RuleSet
 from liansuo.stations.station import Station
 
 from .authority import Authority, Kind, Tracer, other

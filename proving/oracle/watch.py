@@ -12,7 +12,7 @@ import shlex
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-from liansuo.interlocking.rules import RuleSet
+from liansuo.rules import RuleSet
 
 from .check import Finding, Oracle
 
@@ -38,11 +38,13 @@ class Violation:
 class SimulationView:
     """The field as it is, read from a simulation (see :class:`~proving.oracle.view.FieldView`)."""
 
-    def __init__(self, sim: Simulation) -> None:
+    def __init__(self, sim: Simulation, rules: RuleSet | None = None) -> None:
         self.sim = sim
         self.field = sim.field
         st = sim.station
-        self.stop = {s.id: ("A" if s.kind.value == "shunting" else "H") for s in st.model.signals}
+        names = (rules or sim.rules).aspects
+        self.stop = {s.id: frozenset(names.lamps[names.shunt_stop if s.kind.value == "shunting" else names.stop])
+                     for s in st.model.signals}  # the lamps of each signal's stop aspect
         self.platform_keys: dict[str, list[str]] = {}
         for p in st.model.platforms:
             for d in p.screen_doors:
@@ -54,7 +56,7 @@ class SimulationView:
         out = []
         for sig, lamps in self.field.lamps.items():
             commanded = lamps.commanded
-            if commanded and (len(commanded) > 1 or self.stop[sig] not in commanded):
+            if commanded and commanded != self.stop[sig]:
                 out.append(sig)
         return out
 
@@ -62,12 +64,13 @@ class SimulationView:
         lit = set(self.field.lamps[signal].lit())
         fl = self.field.flashers.get(signal)
         if fl is not None and fl.energised and fl.bad_contact:
-            lit.discard("U")  # the flashing lamp stays dark
+            lit.discard(self.field.flasher_lamp)  # the flashing lamp stays dark
         return frozenset(lit)
 
     def flashing(self, signal: str) -> bool:
         fl = self.field.flashers.get(signal)
-        return fl is not None and fl.energised and not fl.bad_contact and "U" in self.field.lamps[signal].lit()
+        return (fl is not None and fl.energised and not fl.bad_contact
+                and self.field.flasher_lamp in self.field.lamps[signal].lit())
 
     def proven_lit(self, signal: str) -> tuple[frozenset[str], bool]:
         lamps = self.field.lamps[signal]
@@ -131,7 +134,7 @@ class Watch:
                  reaction: int = 2) -> None:
         self.sim = sim
         self.oracle = Oracle(sim.station, rules or sim.rules, cycle_s=sim.cycle_s, reaction=reaction)
-        self.view = SimulationView(sim)
+        self.view = SimulationView(sim, rules)
         self.violations: list[Violation] = []
         self.hazards: list[Violation] = []
         self.cycles = 0

@@ -12,8 +12,8 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from liansuo.interlocking.rules import RuleSet, load_rules
 from liansuo.interlocking.table import InterlockingTable, build_table
+from liansuo.rules import RuleSet, load_rules
 from liansuo.stations.loader import load
 from liansuo.stations.station import Station
 
@@ -74,8 +74,8 @@ def verify_station(station: str | Path | Station, *, routes: list[str] | None = 
     against the oracle first (quick), then every route and pair is tried on the running simulation.
     ``stop_at_first``: stop at the first failure (the mutation run only needs to know that one was found)."""
     t0 = time.perf_counter()
-    st = station if isinstance(station, Station) else load(station)
     rules = rules or load_rules()
+    st = station if isinstance(station, Station) else load(station, rules=rules)
     table = build_table(st, rules)
     ctx = Context(st, table, rules, cycle_s, stop_at_first=stop_at_first)
     focus = set(routes) if routes else None

@@ -11,7 +11,7 @@ against the oracle in :mod:`.against`.
 
 from __future__ import annotations
 
-from liansuo.stations.rules import design_rules, min_coded_length
+from liansuo.stations.rules import min_coded_length
 
 from .probe import Context, Failure
 
@@ -20,7 +20,7 @@ _DEAD_ZONE_WORDS = ("dead zone", "staggered")
 
 def check_station(ctx: Context, focus: set[str] | None = None) -> None:
     st = ctx.station
-    rules = design_rules()
+    rules = ctx.rules.design
     for s in st.model.sections:
         if not s.coded:
             continue

@@ -13,8 +13,8 @@ from dataclasses import dataclass, field
 
 from liansuo.interlocking.aspects import is_open, stop_aspect
 from liansuo.interlocking.io import Result
-from liansuo.interlocking.rules import RuleSet
 from liansuo.interlocking.table import InterlockingTable, Route
+from liansuo.rules import RuleSet
 from liansuo.simulation.sim import Simulation
 from liansuo.stations.station import Station
 

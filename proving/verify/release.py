@@ -7,7 +7,7 @@ from __future__ import annotations
 from functools import partial
 from typing import TYPE_CHECKING
 
-from liansuo.interlocking.aspects import ORDER, is_open
+from liansuo.interlocking.aspects import is_open
 from liansuo.interlocking.table import Route
 from liansuo.stations.schema import SignalKind
 
@@ -231,8 +231,9 @@ class ReleaseChecks:
         """Guide aspect HB (引导) over a track-circuit fault on the route: shown with the route locked, closed once
         the guided train has passed."""
         r, sig = self.r, self.st.signals[self.r.signal]
+        guide = self.ctx.rules.aspects.guide
         if r.kind != "train" or sig.kind not in (SignalKind.home, SignalKind.route) or \
-                "B" not in [lamp.value for lamp in sig.lamps] or len(r.sections) < 2:
+                not self.ctx.rules.aspects.can_show(guide, [lamp.value for lamp in sig.lamps]) or len(r.sections) < 2:
             self.na("guide")
             return
         p = Probe(self.ctx)
@@ -254,7 +255,7 @@ class ReleaseChecks:
             p.run(1.0)
         result = p.do(f"guide {r.signal}")
         p.run(1.0)
-        if not self.rt.check(result.ok and p.aspect(r.signal) == "HB", "guide",
+        if not self.rt.check(result.ok and p.aspect(r.signal) == guide, "guide",
                              f"'guide {r.signal}' with {faulty} showing occupied: {result.message}; the signal "
                              f"shows {p.aspect(r.signal)}", p):
             return
@@ -270,12 +271,12 @@ class ReleaseChecks:
                 q.run(1.0)
                 q.do(f"fault psd-stuck {doors[0]}")
                 q.run(1.0)
-                self.rt.check(q.aspect(r.signal) != "HB", "guide", f"screen door of {doors[0]} failed open under "
-                              f"the guide aspect: {r.signal} still shows HB", q)
+                self.rt.check(q.aspect(r.signal) != guide, "guide", f"screen door of {doors[0]} failed open under "
+                              f"the guide aspect: {r.signal} still shows {guide}", q)
         for a in r.approach:
             p.do(f"occupy {a}")
         p.run(1.0)
-        self.rt.check(p.aspect(r.signal) == "HB", "guide", f"the guided train approaches {r.signal}: it shows "
+        self.rt.check(p.aspect(r.signal) == guide, "guide", f"the guided train approaches {r.signal}: it shows "
                       f"{p.aspect(r.signal)}", p)
         p.do(f"occupy {r.sections[0]}")
         p.run(0.5)
@@ -298,7 +299,8 @@ class ReleaseChecks:
         p.do(f"fault filament {r.signal} lamp={lamp} which=both")
         p.run(1.0)
         after = p.aspect(r.signal)
-        self.rt.check(after != shown and ORDER.get(after, 0) <= ORDER.get(shown, 0), "lamp-proving",
+        rank = self.ctx.rules.aspects.rank_of
+        self.rt.check(after != shown and rank(after) <= rank(shown), "lamp-proving",
                       f"lamp {lamp} of {r.signal} dark while it showed {shown}: the interlocking commands {after}", p)
 
     def door_platforms(self) -> list[str]:
@@ -355,7 +357,7 @@ class ReleaseChecks:
                               f"{p.blocker(o)}", p)
                 continue
             self.seen(p)
-            if p.aspect(r.signal) == "USU":
+            if p.aspect(r.signal) in self.ctx.rules.aspects.flashing:
                 self.flasher(p)
             if o.category == "departure":
                 p = Probe(self.ctx)
@@ -390,25 +392,27 @@ class ReleaseChecks:
             p.do(f"occupy {s[0]}")
             p.run(1.0)
             self.seen(p)
-            want = {2: "LU", 1: "U"}[n]
+            want = self.ctx.rules.aspects.automatic_block[n]
             self.rt.check(p.aspect(signal) == want, "aspect", f"{n} clear block section(s) beyond {signal}: it "
                           f"shows {p.aspect(signal)}, expected {want}", p)
 
     def flasher(self, p: Probe) -> None:
         r = self.r
         relay = self.st.signals[r.signal].flasher == "relay"
+        flashing = p.aspect(r.signal)  # called when the signal shows a flashing aspect
         p.do(f"fault flasher {r.signal}")
         p.run(4.0)
         shown = p.aspect(r.signal)
         if relay:
             self.ctx.record(True, "flasher", r.id, "")
-            if shown == "USU":
+            if shown == flashing:
                 self.ctx.warnings.append(Failure(
                     "flasher", r.id, f"signal {r.signal} has a relay flasher (SNJ/SNJJ): a bad SNJ contact darkens the "
-                    "flashing lamp and the interlocking keeps commanding USU (see docs/faults.md)", p.script()))
+                    f"flashing lamp and the interlocking keeps commanding {flashing} (see docs/faults.md)", p.script()))
             return
-        self.rt.check(shown == "UU", "flasher", f"USU flasher of {r.signal} failed: the signal shows {shown}, "
-                      "expected UU", p)
+        want = self.ctx.rules.aspects.downgrade.get(flashing, {}).get("flasher", "")
+        self.rt.check(shown == want, "flasher", f"{flashing} flasher of {r.signal} failed: the signal shows {shown}, "
+                      f"expected {want}", p)
 
 
 def throat_checks(ctx: Context) -> None:
@@ -427,10 +431,11 @@ def throat_checks(ctx: Context) -> None:
             ctx.record(not result.ok, "guide-lock", subject, f"turnout {t} could be thrown under guide total lock: "
                        f"{result.message}", p)
         sig = st.signals.get(throat)
-        if sig is not None and "B" in [lamp.value for lamp in sig.lamps]:
+        guide = ctx.rules.aspects.guide
+        if sig is not None and ctx.rules.aspects.can_show(guide, [lamp.value for lamp in sig.lamps]):
             result = p.do(f"guide {throat}")
             p.run(1.0)
-            ctx.record(result.ok and p.aspect(throat) == "HB", "guide-lock", subject,
+            ctx.record(result.ok and p.aspect(throat) == guide, "guide-lock", subject,
                        f"'guide {throat}' under guide total lock: {result.message}; the signal shows "
                        f"{p.aspect(throat)}", p)
             for pl in _bordering_platforms(ctx, throat):
@@ -439,7 +444,7 @@ def throat_checks(ctx: Context) -> None:
                 p.do(f"fault psd-stuck {pl}")
                 p.run(1.0)
                 again = p.do(f"guide {throat}")
-                ctx.record(p.aspect(throat) != "HB" and not again.ok, "guide-lock", subject,
+                ctx.record(p.aspect(throat) != guide and not again.ok, "guide-lock", subject,
                            f"screen door of {pl} failed open under guide total lock: {throat} shows "
                            f"{p.aspect(throat)}, 'guide {throat}' {'accepted' if again.ok else 'refused'}", p)
                 p.do(f"repair psd-stuck {pl}")

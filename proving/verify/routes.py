@@ -10,7 +10,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from liansuo.interlocking.aspects import ORDER
 from liansuo.interlocking.table import Route
 from liansuo.stations.schema import SectionRole
 
@@ -28,9 +27,10 @@ class RouteResult:
     failures: int = 0
     aspects_seen: set[str] = field(default_factory=set)
     not_applicable: list[str] = field(default_factory=list)
+    order: tuple[str, ...] = ()  # the rule set's aspects, most permissive first: how aspects_seen is listed
 
     def as_dict(self, aspects: tuple[str, ...]) -> dict[str, object]:
-        order = {a: i for i, a in enumerate(("L", "LL", "LU", "USU", "UU", "U", "B"))}
+        order = {a: i for i, a in enumerate(self.order)}
         return {"id": self.id, "checks": self.checks, "failures": self.failures,
                 "aspects_table": list(aspects),
                 "aspects_seen": sorted(self.aspects_seen, key=lambda a: order.get(a, 99)),
@@ -43,7 +43,7 @@ class RouteTest:
     def __init__(self, ctx: Context, r: Route) -> None:
         self.ctx = ctx
         self.r = r
-        self.res = RouteResult(r.id)
+        self.res = RouteResult(r.id, order=ctx.rules.aspects.by_rank)
 
     def check(self, ok: bool, check: str, detail: str, p: Probe | None = None) -> bool:
         self.res.checks += 1
@@ -88,7 +88,7 @@ class RouteTest:
                    f"{'/'.join(r.aspects)}", p)
         if r.end_signal and r.kind == "train":
             # the signal ahead is closed: prepare to stop, the least permissive aspect the table gives
-            least = min(r.aspects, key=lambda a: ORDER.get(a, 0))
+            least = min(r.aspects, key=self.ctx.rules.aspects.rank_of)
             self.check(shown == least, "aspect", f"signal {r.signal} shows {shown} with {r.end_signal} ahead "
                        f"closed; expected {least}", p)
         for rt in r.all_turnouts:

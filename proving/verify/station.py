@@ -60,8 +60,9 @@ def red_lamp_transfer(ctx: Context) -> None:
             a = tracer.trace(s.id, "train", lambda t: None)
             if a.end_signal is not None:
                 rear_blocks.setdefault(a.end_signal, []).append(s.id)
+    names = ctx.rules.aspects
     for s in st.model.signals:
-        if "H" not in {lamp.value for lamp in s.lamps}:
+        if names.stop_lamp not in {lamp.value for lamp in s.lamps}:
             continue
         routes = [r for r in ctx.table.routes.values() if r.kind == "train" and r.end_signal == s.id]
         blocks = rear_blocks.get(s.id, [])
@@ -69,13 +70,13 @@ def red_lamp_transfer(ctx: Context) -> None:
             continue
         subject = f"signal {s.id}"
         p = Probe(ctx)
-        p.do(f"fault filament {s.id} lamp=H which=both")
+        p.do(f"fault filament {s.id} lamp={names.stop_lamp} which=both")
         if s.kind is SignalKind.block:  # a block signal at stop: a train in its section ahead
             p.do(f"occupy {st.tracks[st.signal_entry_track(s.id)].section}")
         p.run(1.0)
         for b in blocks:
-            ctx.record(p.aspect(b) == "H", "red-lamp-transfer", subject, f"the red lamp of {s.id} is dark with it at "
-                       f"stop: block signal {b} in rear shows {p.aspect(b)}", p)
+            ctx.record(p.aspect(b) == names.stop, "red-lamp-transfer", subject, f"the red lamp of {s.id} is dark "
+                       f"with it at stop: block signal {b} in rear shows {p.aspect(b)}", p)
         if routes:
             r = routes[0]
             p.do(route_line(r))

@@ -11,14 +11,12 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from .drivers import driving_rules
-
 if TYPE_CHECKING:
     from ..sim import Simulation
 
 
 def platform_doors(sim: Simulation) -> None:
-    rules = driving_rules()
+    rules = sim.rules.driving
     board = sim.interlocking.board
     for tr in sim.fleet.trains.values():
         ps = tr.platform_stop

@@ -55,9 +55,10 @@ class AutoController:
 
 def _next_signal(sim: Simulation, tr: Train) -> tuple[str | None, float]:
     """The next signal ahead that governs this shunting movement, and the distance to it."""
+    names = sim.rules.aspects
     for dist, node, _ in sim.fleet.track.ahead(tr.pos, 2000.0):
         for sig in sim.station.signals_at(node):
-            if sig.direction is tr.direction and ("B" in [lp.value for lp in sig.lamps]):
+            if sig.direction is tr.direction and names.can_show(names.shunt, [lp.value for lp in sig.lamps]):
                 return sig.id, dist
     return None, 1e9
 
@@ -77,13 +78,14 @@ def inputs_for(sim: Simulation, tr: Train, ctl: AutoController) -> ShuntingInput
         # to a safe distance before the next signal or buffer stop (the track holds no turnouts to lock)
         in_route = True
     aspect = sim.aspect(sig) if sig else ""
+    names = sim.rules.aspects
     plan_route = ctl.current
     return ShuntingInputs(
         authorised_onboard=ctl.authorised_onboard,
         authorised_centre=ctl.authorised_centre,
         shunting_order=plan_route is not None or in_route,
         route_ahead_locked=locked or in_route,
-        signal_ahead_open=aspect in ("B", "L", "LU", "U", "UU", "USU", "LL") or in_route,
+        signal_ahead_open=aspect in names.train_proceed or aspect == names.shunt or in_route,
         plan_matches_route=(plan_route is None and in_route) or (rid is not None and rid == plan_route) or in_route,
         loco_healthy=ctl.loco_healthy,
         perception_healthy=ctl.perception_healthy,

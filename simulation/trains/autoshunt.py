@@ -19,6 +19,8 @@ from dataclasses import dataclass, replace
 from enum import StrEnum
 from typing import Any, Protocol
 
+from liansuo.rules import DARK, Aspects, load_rules
+
 SAFE_DISTANCE_M = 10.0  # stop this far before a closed/blue signal, the station boundary or an obstacle (typical)
 DEPOT_LIMIT_KMH = 8.0  # Liu Huawei et al. 2021 (docs/references.md): depot speed limit
 SERVICE_LIMIT_KMH = 3.0  # Liu Huawei et al. 2021 (docs/references.md): over sanding and washing points (and pits)
@@ -26,7 +28,6 @@ REMOTE_LIMIT_KMH = 5.0  # Liu Jing et al. 2025 (docs/references.md): remote driv
 REMOTE_LIMIT_M = 200.0  # ... and 200 m (or one signal interval)
 ONE_STOP_WINDOW_M = 5.0  # a stand this close before a one-stop point counts as the stop there (typical)
 SERVICE_DECEL_MS2 = 0.3  # braking used for the permitted-speed curve (typical for a light locomotive)
-STOP_ASPECTS = frozenset({"H", "A", ""})  # red, blue, dark: a closed signal
 
 _SERVICE_KINDS = ("sanding", "washing")
 
@@ -392,16 +393,16 @@ class OneStopPoints:
         return ""
 
 
-def stop_target(front_m: float, direction: str, *, signal_at_m: float | None = None, signal_aspect: str = "A",
+def stop_target(front_m: float, direction: str, *, signal_at_m: float | None = None, signal_aspect: str = DARK,
                 boundary_at_m: float | None = None, obstacle_ahead_m: float | None = None,
                 buffer_at_m: float | None = None, one_stop: StopTarget | None = None,
-                safe_distance_m: float = SAFE_DISTANCE_M) -> StopTarget | None:
-    """The nearest point ahead where the front must stop: ``safe_distance_m`` before a closed or blue signal, the
-    station boundary (pass ``boundary_at_m=None`` once the station has given a route beyond), an obstacle or a buffer
-    stop; at a one-stop point. A target behind the front means: stop now."""
+                safe_distance_m: float = SAFE_DISTANCE_M, rules: Aspects | None = None) -> StopTarget | None:
+    """The nearest point ahead where the front must stop: ``safe_distance_m`` before a closed signal (at a stop
+    aspect of the rule set, or dark), the station boundary (pass ``boundary_at_m=None`` once the station has given a
+    route beyond), an obstacle or a buffer stop; at a one-stop point. A target behind the front means: stop now."""
     s = _sign(direction)
     found: list[StopTarget] = []
-    if signal_at_m is not None and signal_aspect in STOP_ASPECTS:
+    if signal_at_m is not None and signal_aspect in (rules or load_rules().aspects).closed:
         found.append(StopTarget(signal_at_m - s * safe_distance_m, f"signal ahead shows {signal_aspect or 'dark'}"))
     if boundary_at_m is not None:
         found.append(StopTarget(boundary_at_m - s * safe_distance_m, "station boundary"))

@@ -2,8 +2,8 @@
 
 - ``manual``: the speed commanded with ``drive``; it does not look at signals and can pass one at danger (the
   interlocking notices);
-- ``signal``: stops short of a closed signal (H, A or dark) and of buffer stops, and keeps to the speed of the last
-  aspect passed (U / UU / USU / HB / B ...);
+- ``signal``: stops short of a closed signal (a stop aspect or dark) and of buffer stops, and keeps to the speed of
+  the last aspect passed (the rule set's ``driving.aspect_speed_kmh``);
 - ``auto``: automatic shunting (Liu Jing et al. 2025, docs/references.md): moves only while the driving conditions hold,
   stops at a safe distance before closed or blue signals and at the station boundary, keeps to the depot limits.
 """
@@ -11,33 +11,13 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import cache
-from importlib.resources import files
 from math import sqrt
 
-import yaml
-
+from liansuo.rules import RuleSet, load_rules
 from liansuo.stations.schema import EndKind, SignalKind
 from liansuo.stations.station import Station
 
 from .movement import Position, Track
-
-STOP_ASPECTS = ("H", "A", "")
-
-
-@dataclass(frozen=True)
-class DrivingRules:
-    aspect_speed_kmh: dict[str, float | None]
-    stop_margin_m: float
-    shunt_margin_m: float
-    buffer_margin_m: float
-    platform_dwell_s: float
-
-
-@cache
-def driving_rules() -> DrivingRules:
-    data = yaml.safe_load((files("liansuo.simulation.trains") / "driving.yaml").read_text(encoding="utf-8"))
-    return DrivingRules(**data)
 
 
 def stopping_speed(distance_m: float, brake_ms2: float) -> float:
@@ -55,30 +35,32 @@ class Ahead:
 
 
 def look_ahead(track: Track, pos: Position, station: Station, aspects: dict[str, str], horizon: float,
-               margin: float, *, shunting: bool, boundary_stops: bool = False) -> list[Ahead]:
+               margin: float, *, shunting: bool, boundary_stops: bool = False,
+               rules: RuleSet | None = None) -> list[Ahead]:
     """Signals, buffer stops and (optionally) the boundary ahead along the rails as they lie now. A train movement
     is governed by train signals only; a shunting movement by shunting signals and signals with a shunting aspect,
-    and it stops before a blue (A) signal."""
+    and it stops before a shunting signal at stop."""
     out: list[Ahead] = []
-    rules = driving_rules()
+    rules = rules or load_rules()
+    names, driving = rules.aspects, rules.driving
     direction = pos.moves[-1][1]
     for dist, node, _move in track.ahead(pos, horizon):
         for sig in station.signals_at(node):
             if sig.direction is not direction:
                 continue
-            has_b = "B" in [lp.value for lp in sig.lamps]
-            if (sig.kind is SignalKind.shunting) != shunting and not (shunting and has_b):
+            shunt_aspect = names.can_show(names.shunt, [lp.value for lp in sig.lamps])
+            if (sig.kind is SignalKind.shunting) != shunting and not (shunting and shunt_aspect):
                 continue  # not this movement's signal
             aspect = aspects.get(sig.id, "")
-            if aspect in STOP_ASPECTS:
+            if aspect in names.closed:
                 out.append(Ahead(dist - margin, 0.0, f"signal {sig.id} at {aspect or 'dark'}"))
                 return out
-            limit = rules.aspect_speed_kmh.get(aspect)
+            limit = driving.aspect_speed_kmh.get(aspect)
             if limit is not None:
                 out.append(Ahead(dist, limit / 3.6, f"signal {sig.id} at {aspect}"))
         end = station.ends.get(node)
         if end is not None and (end.kind is EndKind.buffer or boundary_stops):
-            out.append(Ahead(dist - rules.buffer_margin_m, 0.0, f"{end.kind.value} {node}"))
+            out.append(Ahead(dist - driving.buffer_margin_m, 0.0, f"{end.kind.value} {node}"))
             return out
     return out
 

@@ -11,12 +11,13 @@ from dataclasses import dataclass, field
 
 from liansuo.circuits.field import Field
 from liansuo.circuits.railgeometry import Axle
+from liansuo.rules import RuleSet, load_rules
 from liansuo.stations.schema import Direction
 from liansuo.stations.station import Station
 
 from .autoshunt import EmergencyStops
 from .consist import Consist
-from .drivers import driving_rules, look_ahead, stopping_speed, target_speed
+from .drivers import look_ahead, stopping_speed, target_speed
 from .engine import KinematicEngine, MotionEngine
 from .movement import OUTSIDE, Notify, Position, Track
 from .odometry import Odometer
@@ -82,8 +83,9 @@ class Fleet:
 
     def __init__(self, station: Station, fld: Field, aspects: Aspects, notify: Notify,
                  auto_limit: Callable[[Train], tuple[float, str] | None] | None = None,
-                 engine: MotionEngine | None = None) -> None:
+                 engine: MotionEngine | None = None, rules: RuleSet | None = None) -> None:
         self.auto_limit = auto_limit
+        self.rules = rules or load_rules()  # drivers read its driving part and its aspects
         self.engine: MotionEngine = engine or KinematicEngine()
         self.station = station
         self.field = fld
@@ -189,11 +191,11 @@ class Fleet:
         vmax = c.vmax_kmh / 3.6
         if tr.mode == "manual":
             return min(abs(tr.commanded_kmh) / 3.6, vmax), "driver"
-        rules = driving_rules()
+        rules = self.rules.driving
         horizon = tr.speed_ms ** 2 / (2 * c.brake_ms2) + 400.0
         margin = rules.shunt_margin_m if tr.mode == "auto" else rules.stop_margin_m
         ahead = look_ahead(self.track, tr.pos, self.station, self.aspects(), horizon, margin,
-                           shunting=tr.shunting, boundary_stops=tr.mode == "auto")
+                           shunting=tr.shunting, boundary_stops=tr.mode == "auto", rules=self.rules)
         v, why = target_speed(tr.aspect_limit_ms, vmax, ahead, c.brake_ms2, lead_m=tr.speed_ms * self.dt)
         if tr.mode == "auto" and self.auto_limit is not None:
             extra = self.auto_limit(tr)
@@ -212,7 +214,7 @@ class Fleet:
         return float(stop) if isinstance(stop, float | int) else None
 
     def _note_signals_passed(self, tr: Train, ds: float) -> None:
-        rules = driving_rules()
+        rules = self.rules.driving
         aspects = self.aspects()
         for dist, node, _ in self.track.ahead(tr.pos, ds):
             if dist > ds:
@@ -222,7 +224,7 @@ class Fleet:
                     aspect = aspects.get(sig.id, "")
                     limit = rules.aspect_speed_kmh.get(aspect)
                     tr.aspect_limit_ms = 1e9 if limit is None else limit / 3.6
-                    if aspect in ("H", "A", ""):
+                    if aspect in self.rules.aspects.closed:
                         self.notify("train", f"train {tr.name} passed signal {sig.id} at {aspect or 'dark'}")
 
     # ---- platform stop and doors (Xu Yue et al., docs/references.md) ------------------------------------------------

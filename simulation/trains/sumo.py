@@ -324,7 +324,7 @@ class SumoEngine:
         out: dict[str, str] = {}
         for i in sorted(touched):
             light = lights[i]
-            state = "".join(link_state(sigs, aspects) for sigs in light.links)
+            state = "".join(link_state(sigs, aspects, fleet.rules.aspects) for sigs in light.links)
             if self._lights.get(light.tls) != state:
                 self._lights[light.tls] = out[light.tls] = state
         return out

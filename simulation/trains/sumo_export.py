@@ -31,6 +31,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
+from liansuo.rules import DARK, Aspects, load_rules
 from liansuo.stations.schema import Direction
 from liansuo.stations.station import Station
 from liansuo.stations.topology import Move
@@ -82,20 +83,22 @@ class SumoNetwork:
     def edge(self, move: Move) -> str:
         return self.edges[move]
 
-    def light_states(self, aspects: Mapping[str, str]) -> dict[str, str]:
+    def light_states(self, aspects: Mapping[str, str], rules: Aspects | None = None) -> dict[str, str]:
         """Every traffic light's state string for the given aspects."""
-        return {light.tls: "".join(link_state(sigs, aspects) for sigs in light.links) for light in self.lights}
+        return {light.tls: "".join(link_state(sigs, aspects, rules) for sigs in light.links) for light in self.lights}
 
 
-def link_state(signals: tuple[str, ...], aspects: Mapping[str, str]) -> str:
+def link_state(signals: tuple[str, ...], aspects: Mapping[str, str], rules: Aspects | None = None) -> str:
     """One link's state: ``O`` where no signal governs it, ``G`` while one of its signals shows a proceed aspect,
-    ``g`` for the guide aspect (HB, proceed at 20 km/h), ``r`` for a stop aspect (H, A) or a dark signal."""
+    ``g`` for the guide aspect (proceed at 20 km/h), ``r`` for a stop aspect or a dark signal (``rules``: the rule
+    set's aspects, by default the default rule set's)."""
     if not signals:
         return "O"
-    seen = {aspects.get(s, "") for s in signals}
-    if seen - {"H", "A", "", "HB"}:
+    names = rules or load_rules().aspects
+    seen = {aspects.get(s, DARK) for s in signals}
+    if seen - names.closed - {names.guide}:
         return "G"
-    return "g" if "HB" in seen else "r"
+    return "g" if names.guide in seen else "r"
 
 
 # ---- ids --------------------------------------------------------------------------------------------------------

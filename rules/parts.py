@@ -1,0 +1,100 @@
+"""The parts of a rule set other than its aspects, one per rule file: what each layer reads.
+
+- ``interlocking.yaml`` -> :class:`InterlockingRules` (timers, turnout drive, enemy-route classes, approach locking);
+- ``driving.yaml`` -> :class:`DrivingRules` (the drivers' speeds and margins, read by the trains);
+- ``design.yaml`` -> :class:`DesignRules` (the station-design limits, reported as warnings by the station loader);
+- ``equipment.yaml`` -> :class:`Equipment` (switch machines, screen doors, the obstruction test, read by the field).
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, Literal
+
+from pydantic import BaseModel, ConfigDict, Field
+
+from .reader import Loc
+
+Seconds = Annotated[float, Field(gt=0)]
+Metres = Annotated[float, Field(gt=0)]
+
+
+class Part(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class ApproachLocking(Part):
+    """How far in rear of a signal its approach (接近区段) reaches."""
+
+    home: dict[str, Annotated[int, Field(ge=1)]]  # line kind in rear (automatic, 64d, none) -> block sections
+    other: Annotated[int, Field(ge=1)]  # track sections in rear of every other signal
+
+
+class InterlockingRules(Part):
+    """The interlocking's numbers and tables."""
+
+    release_s: dict[str, Seconds]  # manual time release, by route kind (train, shunt)
+    section_fault_release_s: Seconds
+    overlap_release_s: Seconds  # for an overlap whose station file gives no release_s of its own
+    squeeze_alarm_s: Seconds
+    turnout_concurrency: Annotated[int, Field(ge=1)]
+    turnout_timeout_s: Seconds
+    block_pulse_s: Seconds
+    usu_min_turnout_number: Annotated[int, Field(ge=1)]
+    guide_close_s: Seconds
+    approach_locking: ApproachLocking
+    enemy_onto_track: list[tuple[Literal["train", "shunt"], Literal["train", "shunt"]]]
+
+    def problems(self) -> list[tuple[Loc, str]]:
+        if set(self.release_s) == {"train", "shunt"}:
+            return []
+        return [(("release_s",), "release_s gives one delay for 'train' and one for 'shunt' routes, no other")]
+
+
+class DrivingRules(Part):
+    """What drivers do with what they see."""
+
+    aspect_speed_kmh: dict[str, Annotated[float, Field(gt=0)] | None]  # aspect -> speed past it (None: line speed)
+    stop_margin_m: Metres
+    shunt_margin_m: Metres
+    buffer_margin_m: Metres
+    platform_dwell_s: Seconds
+
+
+class DesignRules(Part):
+    """Station-design limits, each reported as a warning with the measured figure."""
+
+    joint_stagger_max_m: Metres
+    joint_stagger_max_turnout_m: Metres
+    dead_zone_spacing_min_m: Metres
+    dead_zone_spacing_relaxed_m: Metres
+    dead_zone_short_m: Metres
+    fouling_clearance_m: Metres
+    fouling_clearance_emu_m: Metres
+    cab_code_min_time_s: Seconds
+    cab_code_margin_m: Metres
+    coding_speed_kmh: Annotated[float, Field(gt=0)]
+    tuning_area_m: Metres
+    tuning_area_tolerance_m: Metres
+    tuning_dead_zone_max_m: Metres
+    capacitor_min_section_m: Metres
+    phase25hz_max_length_m: Metres
+    bogie_wheelbase_min_m: Metres
+
+
+class MachineSpec(Part):
+    throw_s: Seconds
+    rated_force_N: Annotated[float, Field(gt=0)]
+    nominal_resistance_N: Annotated[float, Field(gt=0)]
+
+
+class DoorSpec(Part):
+    open_s: Seconds
+    close_s: Seconds
+
+
+class Equipment(Part):
+    """Trackside equipment figures."""
+
+    machines: dict[str, MachineSpec]  # by switch machine type (ZD6, ZDJ9, S700K as station files name them)
+    obstruction_lock_mm: Annotated[float, Field(gt=0)]
+    doors: DoorSpec

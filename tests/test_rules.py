@@ -1,0 +1,98 @@
+"""National rule sets: one folder per country, chosen by one name, checked with file and line, read by every layer;
+aspect codes appear only in the rule set and in the Chinese aspect selection."""
+
+from __future__ import annotations
+
+import ast
+import shutil
+from pathlib import Path
+
+import pytest
+
+from liansuo.rules import DEFAULT, FILES, RuleError, RuleSet, bundled, load_rules
+from liansuo.simulation.sim import Simulation
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@pytest.fixture
+def folder(tmp_path: Path) -> Path:
+    """A copy of the Chinese rule set to change."""
+    out = tmp_path / "mine"
+    shutil.copytree(ROOT / "rules" / "china", out)
+    return out
+
+
+def edit(path: Path, old: str, new: str) -> None:
+    text = path.read_text(encoding="utf-8")
+    assert old in text, old
+    path.write_text(text.replace(old, new, 1), encoding="utf-8")
+
+
+def test_the_bundled_rule_set_has_every_part() -> None:
+    assert DEFAULT in bundled()
+    rules = load_rules()
+    assert rules is load_rules(DEFAULT) and rules.name == DEFAULT
+    assert sorted(p.stem for p in (ROOT / "rules" / DEFAULT).glob("*.yaml")) == sorted(FILES)
+    assert rules.aspects.stop in rules.aspects.closed and rules.aspects.guide not in rules.aspects.train_proceed
+    assert rules.lamps is rules.aspects.lamps  # the interlocking reads the aspect tables by their old names
+    assert rules.driving.platform_dwell_s > 0 and rules.design.tuning_area_m > 0 and rules.equipment.machines
+
+
+def test_one_name_chooses_every_part(folder: Path) -> None:
+    edit(folder / "equipment.yaml", "open_s: 3.0", "open_s: 7.0")
+    edit(folder / "driving.yaml", "stop_margin_m: 8", "stop_margin_m: 12")
+    edit(folder / "design.yaml", "bogie_wheelbase_min_m: 1.75", "bogie_wheelbase_min_m: 0.5")
+    edit(folder / "interlocking.yaml", "guide_close_s: 60", "guide_close_s: 45")
+    sim = Simulation("jiaopei", rules=str(folder))
+    assert sim.rules.name == "mine" and sim.interlocking.rules is sim.rules and sim.rules.guide_close_s == 45
+    assert all(d.spec.open_s == 7.0 for d in sim.field.doors.values())
+    assert sim.fleet.rules.driving.stop_margin_m == 12
+    assert len(sim.station.warnings) > len(Simulation("jiaopei").station.warnings)  # dead zones hold a bogie now
+
+
+def test_bad_rule_data_names_file_line_and_what_is_wrong(folder: Path) -> None:
+    edit(folder / "interlocking.yaml", "turnout_concurrency: 6", "turnout_concurrency: 0")
+    edit(folder / "aspects.yaml", "guide: HB ", "guide: BH ")
+    edit(folder / "aspects.yaml", "  B: [B]", "  B: [B, Q]")
+    edit(folder / "aspects.yaml", "  B:   {B: A}", "  B:   {B: L}")
+    edit(folder / "driving.yaml", "  UU: 45", "  UX: 45")
+    edit(folder / "equipment.yaml", "doors:", "dors:")
+    with pytest.raises(RuleError) as exc:
+        load_rules(str(folder))
+    text = str(exc.value)
+    for want in ("interlocking.yaml:10:22: error: turnout_concurrency: Input should be greater than or equal to 1",
+                 "aspects.yaml:15:8: error: 'BH' is no aspect of this rule set",
+                 "lamp 'Q' has no colour", "'B' with 'B' dark shows 'L', which is not more restrictive",
+                 "driving.yaml:8:7: error: 'UX' is no aspect", "equipment.yaml:", "unknown key 'dors'"):
+        assert want in text, (want, text)
+
+
+def test_a_missing_file_or_rule_set_is_named(folder: Path) -> None:
+    (folder / "design.yaml").unlink()
+    with pytest.raises(RuleError, match=r"design\.yaml:1:1: error: no such file"):
+        load_rules(str(folder))
+    with pytest.raises(RuleError, match="no rule set 'atlantis': give one of china"):
+        load_rules("atlantis")
+
+
+def test_a_rule_set_object_is_still_accepted_where_a_name_is() -> None:
+    rules = load_rules().model_copy(update={"turnout_concurrency": 1})
+    assert isinstance(rules, RuleSet) and Simulation("jiaopei", rules=rules).interlocking.rules is rules
+
+
+# ---- aspect codes live in the rule set ------------------------------------------------------------------------------
+def test_no_aspect_or_lamp_code_outside_the_rule_set_and_the_aspect_selection() -> None:
+    """The field, the world and what proves it name aspects by role and lamps by colour or by the station format's
+    Lamp values. (The interlocking's own modules and the console's key and button letters are not scanned here.)"""
+    rules = load_rules()
+    codes = set(rules.lamps) | set(rules.aspects.colours)
+    found = []
+    for layer in ("circuits", "simulation", "proving"):
+        for path in sorted((ROOT / layer).rglob("*.py")):
+            tree = ast.parse(path.read_text(encoding="utf-8"))
+            pieces = {id(v) for n in ast.walk(tree) if isinstance(n, ast.JoinedStr) for v in n.values}  # ids: B1
+            for node in ast.walk(tree):
+                if isinstance(node, ast.Constant) and node.value in codes and id(node) not in pieces:
+                    found.append(f"{path.relative_to(ROOT)}:{node.lineno}: {node.value!r}")
+    assert not found, "name these by their role in the rule set:\n" + "\n".join(found)
