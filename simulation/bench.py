@@ -312,7 +312,7 @@ def measure(station_source: str, *, label: str, text: bool, idle_cycles: int, bu
     out["busy_route_settings"] = sum(d.settings for d in drivers)
     out["busy_traversals"] = sum(d.traversals for d in drivers)
     out["busy_stalls"] = sum(d.stalls for d in drivers)
-    out["alarms"] = len(sim.interlocking.alarms)
+    out["alarms"] = len(sim.view.alarms())
     out["peak_memory_mb"] = round(_peak_rss_mb(), 1)
     return out
 
