@@ -38,11 +38,11 @@ from dataclasses import dataclass
 from typing import Any
 
 from liansuo.interlocking.table import InterlockingTable, Route, build_table
+from liansuo.stations.hubgen import generate_hub
 from liansuo.stations.loader import load, load_text
 from liansuo.stations.station import Station
 
 from .bench_trains import TARGET_TRAINS, run_trains, trains_text
-from .hubgen import generate_hub
 from .sim import Simulation
 
 HUB_TURNOUTS = 200
