@@ -52,7 +52,7 @@ def default_stations() -> list[str]:
     """The bundled stations, the example stations when run from a checkout, and a small generated hub; the quickest
     to verify first."""
     out = sorted(bundled(), key=lambda name: (name != "jiaopei", name))
-    examples = Path(__file__).resolve().parents[2] / "examples" / "stations"
+    examples = Path(__file__).resolve().parents[1] / "examples" / "stations"  # a checkout: proving/ at the top
     if examples.is_dir():
         out[1:1] = [str(p) for p in sorted(examples.glob("*.yaml")) if p.stem != "minimal"]
     return [*out, HUB]
