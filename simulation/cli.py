@@ -130,7 +130,7 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("--engine", choices=("kinematic", "sumo"), default="kinematic",
                     help="what moves the trains: the built-in kinematic model (default) or Eclipse SUMO "
                          "(pip install 'liansuo[sumo]'; see docs/sumo.md)")
-    from .zpwcli import register as register_zpw
+    from liansuo.circuits.zpwcli import register as register_zpw
 
     register_zpw(add)
     _register_plugins(add)
