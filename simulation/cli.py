@@ -98,12 +98,6 @@ def cmd_run(args: argparse.Namespace) -> int:
     return status
 
 
-def cmd_bench(args: argparse.Namespace) -> int:
-    from .bench import main as bench_main
-
-    return bench_main(quick=args.quick, fmt=args.format)
-
-
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="liansuo", description="Station signalling and interlocking simulator (联锁)")
     sub = p.add_subparsers(dest="command", metavar="COMMAND")
@@ -121,18 +115,17 @@ def build_parser() -> argparse.ArgumentParser:
     sp = add("table", cmd_table, "print the interlocking table (联锁表) derived from the topology")
     sp.add_argument("station", help="bundled station name or path")
     sp.add_argument("--format", choices=("text", "csv", "json"), default="text")
-    sp = add("bench", cmd_bench, "benchmark table building and the interlocking cycle (hub and jiaopei)")
-    sp.add_argument("--quick", action="store_true", help="fewer cycles (under a minute)")
-    sp.add_argument("--format", choices=("json", "text"), default="json")
     sp = add("run", cmd_run, "run a scenario headless and print the event log")
     sp.add_argument("scenario", help="scenario YAML file")
     sp.add_argument("--until", metavar="DURATION", help="keep running to this simulated time (e.g. 10min)")
     sp.add_argument("--engine", choices=("kinematic", "sumo"), default="kinematic",
                     help="what moves the trains: the built-in kinematic model (default) or Eclipse SUMO "
                          "(pip install 'liansuo[sumo]'; see docs/sumo.md)")
+    from liansuo.bench.cli import register as register_bench
     from liansuo.circuits.zpwcli import register as register_zpw
 
     register_zpw(add)
+    register_bench(add)
     _register_plugins(add)
     return p
 

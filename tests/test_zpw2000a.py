@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from liansuo.bench import report, zpw
 from liansuo.circuits.zpw2000a import (
     CARRIERS,
     DEFAULT_PARAMS,
@@ -28,7 +29,6 @@ from liansuo.circuits.zpw2000a import (
     standard_positions,
     sweep,
 )
-from liansuo.simulation import bench
 from liansuo.simulation.cli import main
 from liansuo.stations.library import bundled
 from liansuo.stations.loader import load, load_text
@@ -320,10 +320,10 @@ def test_cli_station_without_zpw_sections(capsys: pytest.CaptureFixture[str]) ->
 
 # ---- the benchmark figure ------------------------------------------------------------------------------------------
 def test_bench_reports_zpw_configs_per_s() -> None:
-    figure = bench.measure_zpw(repeats=1)
-    assert figure["configurations"] == len(CARRIERS) * len(bench.ZPW_BALLASTS) * 43 * 141
+    figure = zpw.measure_zpw(repeats=1)
+    assert figure["configurations"] == len(CARRIERS) * len(zpw.ZPW_BALLASTS) * 43 * 141
     assert figure["zpw_configs_per_s"] > 0 and math.isfinite(figure["zpw_configs_per_s"])
-    report = bench.run_bench(bench.Sizes.tiny(), stations=())
-    assert report["zpw"]["zpw_configs_per_s"] > 0
-    assert any(t["figure"] == "zpw_configs_per_s" for t in report["targets"])
-    assert "zpw configs/s" in bench.as_text(report)
+    rep = report.run_bench(report.Sizes.tiny(), stations=())
+    assert rep["zpw"]["zpw_configs_per_s"] > 0
+    assert any(t["figure"] == "zpw_configs_per_s" for t in rep["targets"])
+    assert "zpw configs/s" in report.as_text(rep)
