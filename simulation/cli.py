@@ -67,37 +67,6 @@ def cmd_table(args: argparse.Namespace) -> int:
     return 0
 
 
-def cmd_run(args: argparse.Namespace) -> int:
-    from pathlib import Path
-
-    from .scenario import parse_scenario, run_scenario
-    from .timeparse import parse_duration
-
-    try:
-        sc = parse_scenario(Path(args.scenario))
-    except StationError as exc:
-        return _print_errors(exc)
-    until = None
-    if args.until:
-        try:
-            until = parse_duration(args.until)
-        except ValueError as exc:
-            print(f"--until: {exc}", file=sys.stderr)
-            return 2
-    from .trains.sumo import SumoEngineError
-    from .trains.sumo_export import SumoExportError, SumoUnavailable
-
-    try:
-        status, sim = run_scenario(sc, until, engine=args.engine)
-    except StationError as exc:
-        return _print_errors(exc)
-    except (SumoUnavailable, SumoExportError, SumoEngineError) as exc:  # the SUMO engine could not start
-        print(f"liansuo run --engine {args.engine}: {exc}", file=sys.stderr)
-        return 2
-    sim.close()
-    return status
-
-
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="liansuo", description="Station signalling and interlocking simulator (联锁)")
     sub = p.add_subparsers(dest="command", metavar="COMMAND")
@@ -115,17 +84,13 @@ def build_parser() -> argparse.ArgumentParser:
     sp = add("table", cmd_table, "print the interlocking table (联锁表) derived from the topology")
     sp.add_argument("station", help="bundled station name or path")
     sp.add_argument("--format", choices=("text", "csv", "json"), default="text")
-    sp = add("run", cmd_run, "run a scenario headless and print the event log")
-    sp.add_argument("scenario", help="scenario YAML file")
-    sp.add_argument("--until", metavar="DURATION", help="keep running to this simulated time (e.g. 10min)")
-    sp.add_argument("--engine", choices=("kinematic", "sumo"), default="kinematic",
-                    help="what moves the trains: the built-in kinematic model (default) or Eclipse SUMO "
-                         "(pip install 'liansuo[sumo]'; see docs/sumo.md)")
     from liansuo.bench.cli import register as register_bench
     from liansuo.circuits.zpwcli import register as register_zpw
+    from liansuo.proving.cli import register_run
 
     register_zpw(add)
     register_bench(add)
+    register_run(add)
     _register_plugins(add)
     return p
 

@@ -18,11 +18,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
+from liansuo.simulation.sim import LANGUAGE, Simulation
+from liansuo.simulation.timeparse import parse_duration
 from liansuo.stations.loader import load
 from liansuo.stations.source import Diagnostic, StationError, read_file
-
-from .sim import LANGUAGE, Simulation
-from .timeparse import parse_duration
 
 
 @dataclass
