@@ -11,6 +11,7 @@ from pathlib import Path
 from liansuo.simulation.timeparse import parse_duration
 from liansuo.simulation.trains.sumo import SumoEngineError
 from liansuo.simulation.trains.sumo_export import SumoExportError, SumoUnavailable
+from liansuo.stations.cli import print_errors
 from liansuo.stations.source import StationError
 
 from .junit import write_junit
@@ -18,14 +19,6 @@ from .scenario import parse_scenario, run_scenario
 from .scripts import Outcome, parse_script, run_script
 
 Add = Callable[..., argparse.ArgumentParser]
-
-
-def _print_errors(exc: StationError) -> int:
-    for d in exc.diagnostics:
-        print(d, file=sys.stderr)
-    n = len(exc.diagnostics)
-    print(f"{n} error{'s' if n != 1 else ''}; the station was not loaded", file=sys.stderr)
-    return 1
 
 
 def cmd_test(args: argparse.Namespace) -> int:
@@ -61,7 +54,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     try:
         sc = parse_scenario(Path(args.scenario))
     except StationError as exc:
-        return _print_errors(exc)
+        return print_errors(exc)
     until = None
     if args.until:
         try:
@@ -72,7 +65,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     try:
         status, sim = run_scenario(sc, until, engine=args.engine)
     except StationError as exc:
-        return _print_errors(exc)
+        return print_errors(exc)
     except (SumoUnavailable, SumoExportError, SumoEngineError) as exc:  # the SUMO engine could not start
         print(f"liansuo run --engine {args.engine}: {exc}", file=sys.stderr)
         return 2

@@ -6,7 +6,7 @@ import ast
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-LAYERS = ("stations", "circuits", "interlocking", "simulation", "proving", "bench", "tui")
+LAYERS = ("stations", "circuits", "interlocking", "simulation", "proving", "bench", "tui", "cli")
 
 
 def test_every_layer_is_linked_into_the_package() -> None:

@@ -29,7 +29,7 @@ from liansuo.circuits.zpw2000a import (
     standard_positions,
     sweep,
 )
-from liansuo.simulation.cli import main
+from liansuo.cli.main import main
 from liansuo.stations.library import bundled
 from liansuo.stations.loader import load, load_text
 
