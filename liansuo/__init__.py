@@ -11,10 +11,10 @@ The public API::
     sim.run(5)                                  # simulated seconds
     report = liansuo.verify_station(station)    # the automatic interlocking test (联锁试验)
 
-The packages below are the layers (docs/architecture.md): ``stations`` (the station model), ``circuits`` (trackside
-equipment), ``interlocking`` (the CBI), ``simulation`` (the world around it), ``proving`` (what proves it),
-``tui`` (the operator console). The names here are loaded on first use, so importing one layer does not import the
-others.
+The packages below are the layers (README.md, "Layout"): ``stations`` (the station model), ``circuits`` (trackside
+equipment), ``interlocking`` (the CBI), ``simulation`` (the world around it, with its query API ``sim.view``),
+``proving`` (what proves it), ``bench`` (how fast it runs), ``tui`` (the operator console) and ``cli`` (the command
+line). The names here are loaded on first use, so importing one layer does not import the others.
 """
 
 from __future__ import annotations
