@@ -32,6 +32,9 @@ from .wiring import Wiring
 
 
 class World:
+    """One station's world: built from a station (a bundled name, a path or a :class:`Station`), its rules and its
+    table; ``view`` is the interlocking's query API, ``fleet`` the trains, ``field`` the trackside equipment."""
+
     def __init__(self, station: str | Path | Station, *, cycle_s: float = 0.25, rules: str | RuleSet = "china",
                  table: InterlockingTable | None = None, engine: str | MotionEngine = "kinematic") -> None:
         """``engine``: what moves the trains, "kinematic" (built in, the default) or "sumo" (Eclipse SUMO, the
