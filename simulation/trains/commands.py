@@ -17,7 +17,8 @@ from .fleet import MODES, Fleet, Train
 
 
 class Yard(Protocol):
-    """What the train commands need of the world: the station and its table, the fleet, and the log."""
+    """What the train commands need of the world: the station and its table, the fleet, where the wheelsets stand,
+    automatic shunting, and the log."""
 
     @property
     def station(self) -> Station: ...
