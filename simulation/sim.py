@@ -20,7 +20,6 @@ from .language import Language
 from .trains import ato, automatic
 from .trains.commands import TRAIN_COMMANDS
 from .trains.fleet import Train
-from .view import TrainView
 from .world import World
 
 LANGUAGE: Language[Simulation] = Language(WORLD_COMMANDS, [EXPECT], TRAIN_COMMANDS)
@@ -50,4 +49,4 @@ class Simulation(World):
         ato.platform_doors(self)
 
 
-__all__ = ["LANGUAGE", "Simulation", "TrainView"]
+__all__ = ["LANGUAGE", "Simulation"]
