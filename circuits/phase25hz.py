@@ -59,7 +59,8 @@ class Phase25HzParams:
     relay_transformer_ratio: float = 15.0  # BG25 used as relay (中继) transformer, 1:15
     relay_load_ohm: float = 800.0  # |Z| of track coil with protective box (modelled value)
     relay_load_angle_deg: float = 25.0
-    # JRJC relay and maintenance figures (DOMAIN.md section 4; pick-up/drop textbook-typical, verify)
+    # JRJC relay and maintenance figures (维规 TG/XH 101-2015, docs/references.md; pick-up/drop textbook-typical,
+    # verify)
     pickup_V: float = 15.0  # track-coil voltage at ideal phase that picks the relay up
     drop_V: float = 8.6  # below this in-phase component the relay drops (hysteresis)
     ideal_lag_deg: float = 90.0  # track voltage lags local voltage by this angle for maximum torque

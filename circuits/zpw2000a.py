@@ -37,7 +37,7 @@ CArray = npt.NDArray[Any]  # complex128
 FArray = npt.NDArray[Any]  # float64
 BASE_CARRIERS = ("1700", "2000", "2300", "2600")
 CARRIERS = tuple(f"{b}-{v}" for b in BASE_CARRIERS for v in (1, 2))
-VARIANT_OFFSET_HZ = {"1": 1.4, "2": -1.3}  # DOMAIN.md section 4: -1 is +1.4 Hz, -2 is -1.3 Hz
+VARIANT_OFFSET_HZ = {"1": 1.4, "2": -1.3}  # TB/T 3206 (docs/references.md): -1 is +1.4 Hz, -2 is -1.3 Hz
 FAULT_MODES = ("open", "half", "short")
 End = Literal["upper", "lower"]
 
@@ -64,11 +64,11 @@ class ZpwParams:
     # verify)
     rail_resistance_ohm_km: tuple[float, float, float, float] = (1.177, 1.306, 1.435, 1.558)
     rail_inductance_mH_km: tuple[float, float, float, float] = (1.314, 1.304, 1.297, 1.291)
-    ballast_ohm_km: float = 1.0  # DOMAIN.md: design (minimum) value, at which sections are adjusted
+    ballast_ohm_km: float = 1.0  # TB/T 3206: design (minimum) value, at which sections are adjusted
     # compensation capacitors (typical line values; station coding uses 80/80/60/60 uF)
     capacitance_uF: tuple[float, float, float, float] = (55.0, 50.0, 46.0, 40.0)
-    capacitor_spacing_m: float = 100.0  # DOMAIN.md: about every 100 m, half a spacing at the ends
-    capacitor_min_section_m: float = 300.0  # DOMAIN.md / Luo Ying 2023 (docs/references.md): only sections over 300 m
+    capacitor_spacing_m: float = 100.0  # TB/T 3206: about every 100 m, half a spacing at the ends
+    capacitor_min_section_m: float = 300.0  # Luo Ying 2023 (docs/references.md): only sections over 300 m
     capacitor_short_ohm: float = 0.01  # a shorted capacitor (modelled)
     # transmitter end (typical: level-1 output 161-170 V, 1:9 matching transformer; impedances modelled)
     transmitter_V: float = 170.0
@@ -76,12 +76,12 @@ class ZpwParams:
     source_ohm: complex = complex(300.0, 0.0)  # transmitter output + cable, equipment side
     receiver_ohm: complex = complex(800.0, 0.0)  # receiver input + cable, equipment side
     tuning_ohm: complex = complex(2.0, 0.5)  # the tuning area at the section's own carrier, rail side (modelled)
-    # receiver (DOMAIN.md: pick-up about 200-210 mV, drop 153 mV)
+    # receiver (维规 TG/XH 101-2015, docs/references.md: pick-up about 200-210 mV, drop 153 mV; verify)
     pickup_mV: float = 210.0
     drop_mV: float = 153.0
     adjust_mV: float = 240.0  # no-train main-track output the attenuator is set to at the design ballast
     # shunts, other faults
-    standard_shunt_ohm: float = 0.15  # DOMAIN.md
+    standard_shunt_ohm: float = 0.15  # TB/T 3206
     broken_rail_ohm: float = 1.0e6
     insulation_short_ohm: float = 0.01
     # cab signal: minimum entry current with the standard shunt (station coding standard, commonly quoted)

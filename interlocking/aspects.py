@@ -10,10 +10,9 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+from liansuo.rules import RuleSet, load_rules
 from liansuo.stations.schema import SignalKind, TurnoutPosition
 from liansuo.stations.station import Station
-
-from .rules import RuleSet, load_rules
 
 if TYPE_CHECKING:
     from collections.abc import Iterable

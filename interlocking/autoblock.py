@@ -5,12 +5,12 @@ from __future__ import annotations
 
 from collections.abc import Callable, Collection, Iterable
 
+from liansuo.rules import RuleSet
 from liansuo.stations.schema import SignalKind
 from liansuo.stations.station import Station
 
 from .aspects import TRAIN_STOP, at_stop_or_dark, block_aspect
 from .io import Outputs
-from .rules import RuleSet
 from .state import RouteStage, RouteState
 
 

@@ -10,13 +10,14 @@ from __future__ import annotations
 
 from collections import deque
 
+from liansuo.rules import RuleSet
+
 from .core import Core
 from .io import Alarm, Event, Outputs, RelayBoard
 from .lifecycle import RouteLifecycle
 from .locks import LockLedger
 from .operations import Operator
 from .route import InterlockingTable
-from .rules import RuleSet
 from .state import RouteState
 
 
@@ -41,6 +42,11 @@ class Interlocking:
         return core.give_outputs(changes)
 
     # ---- what the world reads of the interlocking's state ------------------------------------------------------
+    @property
+    def rules(self) -> RuleSet:
+        """The national rule set it runs."""
+        return self.core.rules
+
     @property
     def out(self) -> Outputs:
         """The outputs: aspects, turnout drives, doors, cab codes, line pulses."""

@@ -18,10 +18,10 @@ from collections import defaultdict
 from collections.abc import Iterable
 from dataclasses import dataclass
 
+from liansuo.rules import RuleSet
 from liansuo.stations.schema import Direction, TurnoutPosition
 
 from .route import Condition, Route
-from .rules import RuleSet
 
 
 @dataclass(frozen=True)

@@ -13,6 +13,7 @@ from __future__ import annotations
 from collections import deque
 from dataclasses import dataclass
 
+from liansuo.rules import RuleSet, load_rules
 from liansuo.stations.schema import SectionRole
 from liansuo.stations.station import Station
 
@@ -22,7 +23,6 @@ from .block64d import BlockLink, line_pulses_in, line_tracks_changed
 from .io import Alarm, DoorCommand, Event, Outputs, RelayBoard
 from .locks import Hold, LockLedger
 from .route import InterlockingTable, Route
-from .rules import RuleSet, load_rules
 from .state import GuideOnly, RouteState, SignalState, TurnoutState
 
 MAX_EVENTS = 20_000

@@ -18,6 +18,7 @@ from itertools import pairwise
 
 import networkx as nx
 
+from liansuo.rules import RuleSet
 from liansuo.stations.schema import Button, Direction, Link, SectionRole, SignalKind, TurnoutPosition
 from liansuo.stations.source import Diagnostic, StationError
 from liansuo.stations.station import Station
@@ -26,7 +27,6 @@ from liansuo.stations.topology import Move, Path
 from .aspects import possible_aspects
 from .conflicts import derive_conflicts
 from .route import KINDS, FoulingSection, InterlockingTable, Kind, Route, RouteTurnout, RunOn
-from .rules import RuleSet
 
 _AT_SIGHT = (SectionRole.station_track, SectionRole.spur)
 

@@ -1,4 +1,4 @@
-"""The interlocking's only window on the world: relay states in, commands out (DESIGN.md principle 1).
+"""The interlocking's only window on the world: relay states in, commands out (docs/architecture.md, principle 1).
 
 ``RelayBoard`` holds the input relays the field reports (track relays GJ, turnout indication relays DBJ/FBJ, lamp
 proving relays DJ, the flasher check, platform-door relays PDKJ/PDQCJ, 64D line pulses) and remembers which changed
@@ -111,7 +111,7 @@ class RelayBoard:
 
 @dataclass
 class DoorCommand:
-    """Relays the interlocking drives for one platform side (DOMAIN.md section 5)."""
+    """Relays the interlocking drives for one platform side (Yu Qinlong 2023, docs/references.md)."""
 
     zckj: bool = False  # platform track occupied / authorised
     kmj: bool = False  # open command

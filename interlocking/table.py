@@ -6,11 +6,11 @@ and run-ons, :mod:`.conflicts` the enemy routes.
 
 from __future__ import annotations
 
+from liansuo.rules import RuleSet, load_rules
 from liansuo.stations.station import Station
 
 from .derive import derive_table
 from .route import Condition, FoulingSection, InterlockingTable, Kind, Role, Route, RouteTurnout, RunOn
-from .rules import RuleSet, load_rules
 
 __all__ = ["Condition", "FoulingSection", "InterlockingTable", "Kind", "Role", "Route", "RouteTurnout", "RunOn",
            "build_table"]

@@ -13,8 +13,9 @@ The public API::
 
 The packages below are the layers (docs/architecture.md): ``rules`` (the national rule sets, docs/rules.md),
 ``stations`` (the station model), ``circuits`` (trackside equipment), ``interlocking`` (the CBI), ``simulation`` (the
-world around it), ``proving`` (what proves it), ``tui`` (the operator console). The names here are loaded on first
-use, so importing one layer does not import the others.
+world around it, with its query API ``sim.view``), ``proving`` (what proves it), ``bench`` (how fast it runs), ``tui``
+(the operator console) and ``cli`` (the command line). The names here are loaded on first use, so importing one layer
+does not import the others.
 """
 
 from __future__ import annotations

@@ -1,4 +1,5 @@
-"""What checks the world: the independent safety oracle (and, as the project grows, verify, soak and scripts).
+"""What checks the world: the independent safety oracle, verify, soak, mutation testing, route-test scripts and
+scenarios, and their pytest plugin and JUnit report.
 
-Nothing here is used by the simulation itself; it stands apart from what it checks (DESIGN.md principle 7).
+Nothing here is used by the simulation itself; it stands apart from what it checks (docs/architecture.md, principle 7).
 """

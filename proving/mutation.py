@@ -17,7 +17,7 @@ from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 
-from liansuo.simulation.hubgen import generate_hub
+from liansuo.stations.hubgen import generate_hub
 from liansuo.stations.library import bundled
 from liansuo.stations.loader import load, load_text
 from liansuo.stations.station import Station

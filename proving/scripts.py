@@ -23,8 +23,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from liansuo.interlocking.io import Result
-from liansuo.simulation.commands import read_steps
-from liansuo.simulation.sim import Simulation
+from liansuo.simulation.sim import LANGUAGE, Simulation
 from liansuo.stations.loader import load
 from liansuo.stations.source import Diagnostic, StationError, read_file
 from liansuo.stations.station import Station
@@ -92,7 +91,7 @@ def parse_script(path: Path) -> Script:
         for key in t:
             if key not in ("name", "steps"):
                 errors.append(src.diagnostic(("tests", i, key), f"unknown key '{key}' in a test", "", at_key=True))
-        steps = [Step(s, line) for s, line in read_steps(src, ("tests", i, "steps"), t["steps"], errors)]
+        steps = [Step(s, line) for s, line in LANGUAGE.read_steps(src, ("tests", i, "steps"), t["steps"], errors)]
         tests.append(ScriptTest(t["name"], steps, src.mark(("tests", i)).line))
     cycle_ms = data.get("cycle_ms", 250)
     if not isinstance(cycle_ms, int | float) or isinstance(cycle_ms, bool) or not 10 <= cycle_ms <= 2000:

@@ -17,7 +17,6 @@ from pathlib import Path
 
 from liansuo.interlocking.aspects import is_open
 from liansuo.interlocking.table import Route
-from liansuo.simulation.commands import COMMANDS
 from liansuo.simulation.sim import Simulation
 from liansuo.stations.schema import Direction
 from liansuo.stations.station import Station
@@ -55,7 +54,7 @@ class StepGenerator:
         self.zpw = [s.id for s in st.model.sections if s.type.value == "zpw2000a"]
         self.walkers: dict[str, Walker] = {}
         self.serial = 0
-        self.trains = "train" in COMMANDS
+        self.trains = "train" in sim.language
         families = [(self.route, 18), (self.signal_op, 10), (self.turnout_op, 6), (self.occupancy, 5),
                     (self.fault, 4), (self.disturb, 6), (self.repair, 6), (self.walk, 22), (self.wait, 3)]
         if self.links64:

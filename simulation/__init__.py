@@ -1,4 +1,5 @@
-"""The world around the interlocking: clock, field, command language, scripts, CLI.
+"""The world around the interlocking: the clock, the field, the trains, the query API every front end reads
+(:mod:`.view`) and the command language (:mod:`.language`) that drives it all.
 
 Python API::
 

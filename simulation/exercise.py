@@ -24,8 +24,7 @@ from pathlib import Path
 from liansuo.stations.library import bundled
 from liansuo.stations.source import Diagnostic, StationError, read_file
 
-from .commands import read_steps
-from .sim import Simulation
+from .sim import LANGUAGE, Simulation
 
 KEYS = ("title", "station", "description", "setup", "goal")
 GOAL_KEYS = ("description", "expect")
@@ -78,7 +77,7 @@ def parse_exercise(path: str | Path) -> Exercise:
     if not isinstance(raw, list):
         errors.append(src.diagnostic(("setup",), "'setup:' is a list of commands", ""))
         raw = []
-    setup = [s for s, _ in read_steps(src, ("setup",), raw, errors)]
+    setup = [s for s, _ in LANGUAGE.read_steps(src, ("setup",), raw, errors)]
     goal = data.get("goal", {}) or {}
     expect: list[str] = []
     if not isinstance(goal, dict):

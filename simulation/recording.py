@@ -20,12 +20,11 @@ import json
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import IO, TYPE_CHECKING, Any
+from typing import IO, Any
 
 from liansuo.interlocking.io import Result
 
-if TYPE_CHECKING:
-    from .sim import Simulation
+from .sim import Simulation
 
 FORMAT = "liansuo-recording"
 VERSION = 1
@@ -36,19 +35,18 @@ State = dict[str, dict[str, dict[str, Any]]]
 
 def snapshot(sim: Simulation) -> State:
     """Relay inputs and outputs of the interlocking now, as plain JSON values."""
-    il = sim.interlocking
-    board = il.board
+    board, out = sim.view.inputs, sim.view.outputs
     st = sim.station
     return {
         "in": {
             "gj": {s: board.clear(s) for s in st.sections},
             "ind": {t: board.indication(t) for t in st.turnouts},
             "dj": {s: sorted(lamp for lamp, ok in board.lamps.get(s, {}).items() if ok) for s in st.signals},
-            "pd": {k: [board.pdkj.get(k, False), board.pdqcj.get(k, False)] for k in il.out.doors},
+            "pd": {k: [board.pdkj.get(k, False), board.pdqcj.get(k, False)] for k in out.doors},
         },
         "out": {
-            "sig": dict(sorted(il.out.signals.items())),
-            "drv": {t: il.out.turnouts.get(t) for t in st.turnouts},
+            "sig": dict(sorted(out.signals.items())),
+            "drv": {t: out.turnouts.get(t) for t in st.turnouts},
             "sec": {s: sim.section_state(s) for s in st.sections},
         },
     }
@@ -286,8 +284,6 @@ class Replayer:
 
 
 def _default_sim(station: str, cycle_s: float) -> Simulation:
-    from .sim import Simulation
-
     return Simulation(station, cycle_s=cycle_s)
 
 

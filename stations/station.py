@@ -1,4 +1,4 @@
-"""A validated station: the file's model plus indices and the topology built from it."""
+"""A validated station: the file's model plus indices, and the topology graph built from it on first use."""
 
 from __future__ import annotations
 
@@ -239,6 +239,6 @@ class Station:
 
     @cached_property
     def topology(self) -> Topology:
-        from .topology import Topology  # built on first use; the graph is not needed to check a file
+        from .topology import Topology  # networkx loads on first use: checking a file needs no graph
 
         return Topology(self)

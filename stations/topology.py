@@ -5,19 +5,49 @@ Edges join a movement to the movements it can continue into at the far node. Thr
 point -> normal, point -> reverse, normal -> point or reverse -> point, never normal -> reverse; each edge carries the
 turnout and the position it needs. A direction never changes along a path because every node has its legs on
 opposite sides, so "paths from a signal in its direction" are paths in this graph.
+
+The graph is built from a :class:`Network`, the little of a station it needs; a
+:class:`~stations.station.Station` is one and offers its graph as ``Station.topology``, so the station stands on
+this module and not the other way round.
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
+from typing import Protocol
 
 import networkx as nx
 
-from .schema import Direction, TurnoutPosition
-from .station import Station
+from .schema import Direction, Joint, Signal, Track, Turnout, TurnoutPosition
 
 Move = tuple[str, Direction]
+
+
+class TrackEnd(Protocol):
+    @property
+    def node(self) -> str: ...
+
+
+class Network(Protocol):
+    """The tracks, nodes and signals of a station: what the graph is built from and what its paths are told in."""
+
+    @property
+    def tracks(self) -> Mapping[str, Track]: ...
+    @property
+    def joints(self) -> Mapping[str, Joint]: ...
+    @property
+    def turnouts(self) -> Mapping[str, Turnout]: ...
+    @property
+    def signals(self) -> Mapping[str, Signal]: ...
+    @property
+    def node_tracks(self) -> Mapping[str, list[tuple[str | None, str]]]: ...
+    def joint_tracks(self, joint: str) -> tuple[str, str]: ...
+    def turnout_points_down(self, turnout: str) -> bool: ...
+    def track_low_port(self, track: str) -> TrackEnd: ...
+    def track_high_port(self, track: str) -> TrackEnd: ...
+    def entry_track(self, node: str, direction: Direction) -> str: ...
+    def track_length(self, track: str) -> float: ...
 
 
 @dataclass(frozen=True)
@@ -40,7 +70,7 @@ class Path:
 class Topology:
     """Answers path questions about one station."""
 
-    def __init__(self, station: Station) -> None:
+    def __init__(self, station: Network) -> None:
         self.station = station
         self.graph = nx.DiGraph()
         st = station

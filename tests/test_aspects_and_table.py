@@ -10,10 +10,10 @@ from conftest import Driver
 from hypothesis import given
 from hypothesis import strategies as st
 
+from liansuo.cli.main import main
 from liansuo.interlocking.aspects import downgrade
-from liansuo.interlocking.rules import load_rules
 from liansuo.interlocking.table import build_table
-from liansuo.simulation.cli import main
+from liansuo.rules import load_rules
 from liansuo.stations.library import bundled
 from liansuo.stations.loader import load, load_text
 from liansuo.stations.source import StationError

@@ -8,12 +8,13 @@ from collections import Counter
 
 import pytest
 
+from liansuo.bench import report as bench
+from liansuo.bench.busy import busy_routes
+from liansuo.bench.report import Sizes, all_finite, as_text, run_bench
+from liansuo.cli.main import main
 from liansuo.interlocking.table import build_table
-from liansuo.simulation import bench
-from liansuo.simulation.bench import Sizes, all_finite, as_text, busy_routes, run_bench
-from liansuo.simulation.cli import main
-from liansuo.simulation.hubgen import generate_hub
 from liansuo.simulation.sim import Simulation
+from liansuo.stations.hubgen import generate_hub
 from liansuo.stations.loader import load_text
 
 STATION_KEYS = {

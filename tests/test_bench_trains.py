@@ -7,10 +7,10 @@ from typing import Any
 
 import pytest
 
+from liansuo.bench.trains import run_trains, train_slots, trains_text
 from liansuo.interlocking.table import InterlockingTable, build_table
-from liansuo.simulation.bench_trains import run_trains, train_slots, trains_text
-from liansuo.simulation.hubgen import generate_hub
 from liansuo.simulation.trains.sumo import sumo_installed
+from liansuo.stations.hubgen import generate_hub
 from liansuo.stations.loader import load_text
 from liansuo.stations.station import Station
 

@@ -1,4 +1,4 @@
-"""97-type 25 Hz phase-sensitive track circuit: the figures a maintainer checks (DOMAIN.md section 4).
+"""97-type 25 Hz phase-sensitive track circuit: the figures a maintainer checks (维规, docs/references.md).
 
 Adjustment >= 18 V on the track coil (typical 15-26 V), residual <= 7.4 V with the 0.06 ohm standard shunt anywhere
 in the section, lengths up to 1500 m, phase selectivity, and the red band for broken rail / failed insulation.

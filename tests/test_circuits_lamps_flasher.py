@@ -1,4 +1,4 @@
-"""Signal lamps with DJ proving, and the USU flasher (Chen Xinmei 2023, docs/references.md; DOMAIN.md section 2)."""
+"""Signal lamps with DJ proving, and the USU flasher (Chen Xinmei 2023, docs/references.md; 技规)."""
 
 from __future__ import annotations
 

@@ -10,7 +10,7 @@ import pytest
 import yaml
 from jsonschema import Draft202012Validator
 
-from liansuo.simulation.cli import main
+from liansuo.cli.main import main
 from liansuo.stations.library import bundled
 
 ROOT = Path(__file__).resolve().parent.parent

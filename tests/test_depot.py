@@ -6,8 +6,8 @@ from __future__ import annotations
 import pytest
 from conftest import Driver
 
+from liansuo.cli.main import main
 from liansuo.interlocking.table import build_table
-from liansuo.simulation.cli import main
 from liansuo.simulation.sim import Simulation
 from liansuo.stations.loader import load
 from liansuo.stations.schema import EndKind, Lamp, SectionRole, SignalKind

@@ -5,8 +5,13 @@ from __future__ import annotations
 import ast
 from pathlib import Path
 
+import networkx as nx
+
 ROOT = Path(__file__).resolve().parents[1]
-LAYERS = ("rules", "stations", "circuits", "interlocking", "simulation", "proving", "tui")
+LAYERS = ("rules", "stations", "circuits", "interlocking", "simulation", "proving", "bench", "tui", "cli")
+# the floor of each layer: a module imports only from its own layer or from a lower floor (README.md, "Layout")
+FLOOR = {"rules": 0, "stations": 1, "circuits": 2, "interlocking": 2, "simulation": 3, "proving": 4, "bench": 4,
+         "tui": 4, "cli": 5}
 
 
 def test_every_layer_is_linked_into_the_package() -> None:
@@ -29,3 +34,42 @@ def test_no_module_imports_a_layer_by_its_bare_name() -> None:
             bare += [f"{path.relative_to(ROOT)}:{node.lineno}: {n}" for n in names if n.split(".")[0] in LAYERS]
     assert len(files) > 100
     assert not bare, "import these as liansuo.<layer>:\n" + "\n".join(bare)
+
+
+def _imports() -> nx.DiGraph:
+    """Module -> module it imports (anywhere in the file: at the top, in a function, for type checking only)."""
+    files: dict[str, Path] = {}
+    for layer in LAYERS:
+        for p in (ROOT / layer).rglob("*.py"):
+            parts = p.relative_to(ROOT).with_suffix("").parts
+            files[".".join(("liansuo", *(parts[:-1] if parts[-1] == "__init__" else parts)))] = p
+    graph = nx.DiGraph()
+    for mod, path in files.items():
+        package = mod if path.name == "__init__.py" else mod.rpartition(".")[0]
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.Import):
+                names = [a.name for a in node.names]
+            elif isinstance(node, ast.ImportFrom):
+                base = node.module or ""
+                if node.level:
+                    up = package.rsplit(".", node.level - 1)[0] if node.level > 1 else package
+                    base = f"{up}.{base}" if base else up
+                names = [base, *(f"{base}.{a.name}" for a in node.names)]
+            else:
+                continue
+            for name in names:
+                while name and name not in files:
+                    name = name.rpartition(".")[0]
+                if name and name != mod and not mod.startswith(f"{name}."):  # not its own package's __init__
+                    graph.add_edge(mod, name)
+    return graph
+
+
+def test_imports_point_down_and_close_no_circle() -> None:
+    graph = _imports()
+    assert graph.number_of_edges() > 300
+    up = [f"{a} -> {b}" for a, b in graph.edges
+          if (la := a.split(".")[1]) != (lb := b.split(".")[1]) and FLOOR[lb] >= FLOOR[la]]
+    assert not up, "imports that do not point down:\n" + "\n".join(up)
+    circles = [" -> ".join(c) for c in nx.simple_cycles(graph)]
+    assert not circles, "modules that import each other:\n" + "\n".join(circles)

@@ -7,9 +7,9 @@ import json
 
 import pytest
 
+from liansuo.cli.main import main
 from liansuo.proving.mutants import MUTANTS
 from liansuo.proving.mutation import run_mutants
-from liansuo.simulation.cli import main
 
 
 def test_at_least_twenty_distinct_defects_and_95_percent_caught() -> None:

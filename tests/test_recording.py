@@ -7,8 +7,8 @@ from pathlib import Path
 
 import pytest
 
+from liansuo.cli.main import main
 from liansuo.simulation import Simulation
-from liansuo.simulation.cli import main
 from liansuo.simulation.exercise import bundled_exercises, check_goal, parse_exercise
 from liansuo.simulation.recording import FileRecorder, Recorder, RecordingError, Replayer, load_recording
 from liansuo.stations.source import StationError

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from conftest import Driver
 
-from liansuo.interlocking.rules import load_rules
+from liansuo.rules import load_rules
 from liansuo.simulation.sim import Simulation
 
 

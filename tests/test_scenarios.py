@@ -6,8 +6,8 @@ from pathlib import Path
 
 import pytest
 
-from liansuo.simulation.cli import main
-from liansuo.simulation.scenario import parse_scenario, run_scenario
+from liansuo.cli.main import main
+from liansuo.proving.scenario import parse_scenario, run_scenario
 
 SCENARIOS = sorted((Path(__file__).parent.parent / "examples" / "scenarios").glob("*.yaml"))
 

@@ -7,7 +7,7 @@ from xml.etree import ElementTree
 
 import pytest
 
-from liansuo.simulation.cli import main
+from liansuo.cli.main import main
 
 EXAMPLES = sorted((Path(__file__).parent.parent / "examples" / "scripts").glob("*.yaml"))
 

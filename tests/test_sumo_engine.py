@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 from conftest import Driver
 
-from liansuo.simulation.cli import main as cli_main
+from liansuo.cli.main import main as cli_main
 from liansuo.simulation.sim import Simulation
 from liansuo.simulation.trains import sumo as sumo_module
 from liansuo.simulation.trains.sumo import SumoEngine, SumoEngineError, sumo_installed

@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 from conftest import Driver
 
-from liansuo.simulation.scenario import parse_scenario, run_scenario
+from liansuo.proving.scenario import parse_scenario, run_scenario
 from liansuo.simulation.sim import Simulation
 from liansuo.simulation.trains.sumo import sumo_installed
 

@@ -8,11 +8,11 @@ from pathlib import Path
 
 import pytest
 
+from liansuo.cli.main import main
 from liansuo.interlocking.lifecycle import RouteLifecycle
 from liansuo.interlocking.operations import Operator
 from liansuo.proving.scripts import Script, ScriptTest, Step, run_test
 from liansuo.proving.verify import verify_station
-from liansuo.simulation.cli import main
 from liansuo.stations.library import bundled
 from liansuo.stations.loader import load
 

@@ -109,7 +109,7 @@ def lamp(app, signal):
 async def main():
     app = ConsoleApp("jiaopei", paused=True)
     async with app.run_test(size=(120, 36)) as pilot:
-        print("lamp X before", *lamp(app, "X"), "red" if lamp(app, "X")[1] == LAMP_COLOUR["H"] else "not red")
+        print("lamp X before", *lamp(app, "X"), "red" if lamp(app, "X")[1] == LAMP_COLOUR["red"] else "not red")
         for button in ("X", "XI"):
             await pilot.click(Diagram, offset=app.diagram.offset_of(Ref("button", button, "train")))
             await pilot.pause()
@@ -117,7 +117,8 @@ async def main():
         app.refresh_views()
         print("answer", app.message_line.content)
         print("route X-XI", app.sim.route_state("X-XI"))
-        print("lamp X after", *lamp(app, "X"), "yellow" if lamp(app, "X")[1] == LAMP_COLOUR["U"] else "not yellow")
+        after = lamp(app, "X")
+        print("lamp X after", *after, "yellow" if after[1] == LAMP_COLOUR["yellow"] else "not yellow")
 
 
 asyncio.run(main())

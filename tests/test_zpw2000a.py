@@ -1,4 +1,4 @@
-"""ZPW-2000A transmission-line model: DOMAIN.md figures, the capacitor-fault trends of Luo Ying 2023
+"""ZPW-2000A transmission-line model: the figures of TB/T 3206 and 维规, the capacitor-fault trends of Luo Ying 2023
 (docs/references.md), the vectorised sweep against single evaluations, hysteresis, faults, and ``liansuo zpw``."""
 
 from __future__ import annotations
@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from liansuo.bench import report, zpw
 from liansuo.circuits.zpw2000a import (
     CARRIERS,
     DEFAULT_PARAMS,
@@ -28,8 +29,7 @@ from liansuo.circuits.zpw2000a import (
     standard_positions,
     sweep,
 )
-from liansuo.simulation import bench
-from liansuo.simulation.cli import main
+from liansuo.cli.main import main
 from liansuo.stations.library import bundled
 from liansuo.stations.loader import load, load_text
 
@@ -68,7 +68,7 @@ def cab(circuit: ZpwCircuit, x: float, faults: ZpwFaults | None = None) -> float
     return current
 
 
-# ---- DOMAIN.md figures and the station ----------------------------------------------------------------------------
+# ---- standard figures and the station ------------------------------------------------------------------------------
 def test_carriers_and_capacitor_layout() -> None:
     assert carrier_frequency_Hz("1700-1") == pytest.approx(1701.4)
     assert carrier_frequency_Hz("2600-2") == pytest.approx(2598.7)
@@ -320,10 +320,10 @@ def test_cli_station_without_zpw_sections(capsys: pytest.CaptureFixture[str]) ->
 
 # ---- the benchmark figure ------------------------------------------------------------------------------------------
 def test_bench_reports_zpw_configs_per_s() -> None:
-    figure = bench.measure_zpw(repeats=1)
-    assert figure["configurations"] == len(CARRIERS) * len(bench.ZPW_BALLASTS) * 43 * 141
+    figure = zpw.measure_zpw(repeats=1)
+    assert figure["configurations"] == len(CARRIERS) * len(zpw.ZPW_BALLASTS) * 43 * 141
     assert figure["zpw_configs_per_s"] > 0 and math.isfinite(figure["zpw_configs_per_s"])
-    report = bench.run_bench(bench.Sizes.tiny(), stations=())
-    assert report["zpw"]["zpw_configs_per_s"] > 0
-    assert any(t["figure"] == "zpw_configs_per_s" for t in report["targets"])
-    assert "zpw configs/s" in bench.as_text(report)
+    rep = report.run_bench(report.Sizes.tiny(), stations=())
+    assert rep["zpw"]["zpw_configs_per_s"] > 0
+    assert any(t["figure"] == "zpw_configs_per_s" for t in rep["targets"])
+    assert "zpw configs/s" in report.as_text(rep)

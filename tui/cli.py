@@ -1,4 +1,4 @@
-"""``liansuo tui`` and ``liansuo replay``, registered through the ``liansuo.commands`` entry-point group.
+"""``liansuo tui`` and ``liansuo replay``, registered by the command line (``cli/main.py``).
 
 Textual is imported only when a console actually starts, so the rest of the command line stays quick.
 """

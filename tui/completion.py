@@ -1,4 +1,4 @@
-"""Completion for the command bar, from the command language's own ``COMMANDS`` and ``USAGE``.
+"""Completion for the command bar, from the simulation's command language: its commands and their usage lines.
 
 The usage line of a command names what each argument is (``SIGNAL``, ``SECTION``, ``TURNOUT``, ``normal|reverse``,
 ``[key=value ...]``); the candidates are the station's ids of that kind.
@@ -20,12 +20,6 @@ _EXPECT = {
     "block-line": ("LINK", "idle|requested|permitted|departed|asked|accepted|arriving|arrived"),
     "code": ("SECTION", "L|LU|U|UU|UUS|HU|HB|none"),
 }
-
-
-def _commands() -> tuple[dict[str, object], dict[str, str]]:
-    from liansuo.simulation.commands import COMMANDS, USAGE
-
-    return dict(COMMANDS), dict(USAGE)
 
 
 def placeholders(usage: str) -> list[str]:
@@ -125,9 +119,9 @@ def candidates(sim: Simulation, text: str) -> list[str]:
     words = text.split(" ")
     partial = words[-1]
     done = [w for w in words[:-1] if w]
-    commands, usage = _commands()
+    language = sim.language
     if not done:
-        pool = sorted(commands)
+        pool = sorted(language)
     else:
         cmd = done[0]
         if cmd == "expect":
@@ -138,7 +132,7 @@ def candidates(sim: Simulation, text: str) -> list[str]:
                 i = len(done) - 2
                 pool = _ids(sim, shape[i], done) if i < len(shape) else []
         else:
-            slots = placeholders(usage.get(cmd, ""))
+            slots = placeholders(language.usage(cmd))
             i = len(done) - 1
             if i < len(slots):
                 slot = slots[i]

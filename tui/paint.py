@@ -62,28 +62,24 @@ class Frame:
 
 
 def read_frame(sim: Simulation, lay: Layout) -> Frame:
-    il = sim.interlocking
+    view = sim.view
     st = sim.station
-    sections = {s: sim.section_state(s) for s in st.sections}
-    turnouts: dict[str, tuple[str | None, str]] = {}
-    for t in il.core.turnouts:
-        turnouts[t] = (il.board.indication(t), sim.turnout_mark(t))
+    sections = {s.id: s.state for s in view.sections(list(st.sections))}
+    turnouts = {t.id: (t.position, t.mark) for t in view.turnouts()}
     lamps: dict[str, list[tuple[str, bool]]] = {}
     colours = sim.rules.aspects.colours
     mast = list(colours)  # the rule set lists the lamps in their order on the mast
     for sig in st.model.signals:
         have = [lamp.value for lamp in sig.lamps]
         lit = sim.field.lit_lamps(sig.id)
-        aspect = il.out.signals.get(sig.id, "")
-        want = [lamp for lamp in sim.rules.lamps.get(aspect, []) if lamp in have]
+        want = [lamp for lamp in sim.rules.lamps.get(view.aspect(sig.id), []) if lamp in have]
         shown = sorted(set(want) | (lit & set(have)), key=lambda x: mast.index(x) if x in mast else 9)
         lamps[sig.id] = [(colours.get(lamp, ""), lamp in lit) for lamp in shown]
     countdown: dict[str, int] = {}
-    for rs in il.routes.values():
-        if sim.route_state(rs.id) == "time_release" and rs.release_at is not None:
-            countdown[rs.route.signal] = max(0, int(rs.release_at - sim.t + 0.999))
-    alarmed = {key.split(":")[1] for key in il.alarms if key.startswith(("closed:", "lamp:", "red:", "filament:",
-                                                                          "flasher:"))}
+    for r in view.routes():
+        if r.state == "time_release" and r.release_at is not None:
+            countdown[r.signal] = max(0, int(r.release_at - sim.t + 0.999))
+    alarmed = {s.id for s in view.signals() if s.alarmed}
     doors: dict[str, str] = {}
     for key, d in sim.field.doors.items():
         doors[key] = "bypass" if d.pdqcj else "open" if d.is_open else "closed"

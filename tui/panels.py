@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, ClassVar
 
@@ -37,18 +37,15 @@ class StatusBar(Static):
 @dataclass
 class AlarmLine:
     key: str
-    t: float
+    t: float | None  # None: the world keeps no time for its alarms
     text: str
     acknowledged: bool
 
 
 def read_alarms(sim: Simulation, acknowledged: set[str]) -> list[AlarmLine]:
     """Active alarms of the interlocking and of the world (trains), newest first."""
-    out = [AlarmLine(a.key, a.t, a.text, a.key in acknowledged) for a in sim.interlocking.alarms.values()]
-    world = getattr(sim, "alarms", None)
-    if isinstance(world, dict):
-        out += [AlarmLine(f"world:{k}", -1.0, str(v), f"world:{k}" in acknowledged) for k, v in world.items()]
-    out.sort(key=lambda a: a.t, reverse=True)
+    out = [AlarmLine(a.key, a.t, a.text, a.key in acknowledged) for a in sim.alarm_views()]
+    out.sort(key=lambda a: -1.0 if a.t is None else a.t, reverse=True)
     return out
 
 
@@ -83,7 +80,7 @@ class AlarmPanel(Widget):
         for i, a in enumerate(self.lines):
             if i:
                 out.append("\n")
-            when = f"{a.t:7.1f} " if a.t >= 0 else "        "
+            when = f"{a.t:7.1f} " if a.t is not None else "        "
             if a.acknowledged:
                 out.append(when + a.text, style="#c08080")
             else:
@@ -125,10 +122,7 @@ class EventReader:
         self._last = {}
 
     def new(self, sim: Simulation) -> list[tuple[float, str, str]]:
-        sources = [sim.interlocking.events]
-        world = getattr(sim, "events", None)
-        if world is not None and world is not sim.interlocking.events:
-            sources.append(world)
+        sources: list[Sequence[Event]] = [sim.view.events(), sim.events]
         fresh: list[Event] = []
         for i, dq in enumerate(sources):
             last = self._last.get(i)

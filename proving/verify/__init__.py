@@ -23,7 +23,8 @@ from .data import check_station
 from .pairs import PairTest
 from .probe import Context, Failure, FirstFailure
 from .release import throat_checks
-from .routes import RouteResult, RouteTest
+from .routecheck import RouteResult
+from .routes import RouteTest
 from .station import power_up, red_lamp_transfer
 
 

@@ -5,20 +5,17 @@ aspect, platform screen doors, and the aspects the signal shows with the onward 
 from __future__ import annotations
 
 from functools import partial
-from typing import TYPE_CHECKING
 
 from liansuo.interlocking.aspects import is_open
 from liansuo.interlocking.table import Route
 from liansuo.stations.schema import SignalKind
 
 from .probe import Context, Failure, Probe, against_running, open_route, other, route_line
-
-if TYPE_CHECKING:
-    from .routes import RouteTest
+from .routecheck import RouteCheck
 
 
 class ReleaseChecks:
-    def __init__(self, rt: RouteTest) -> None:
+    def __init__(self, rt: RouteCheck) -> None:
         self.rt = rt
         self.ctx = rt.ctx
         self.r = rt.r

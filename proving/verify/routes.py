@@ -1,4 +1,4 @@
-"""The interlocking test (联锁试验) of one route, item by item as on a real test record (DOMAIN.md section 3): the
+"""The interlocking test (联锁试验) of one route, item by item as on a real test record (维规, docs/references.md): the
 signal opens with an aspect of the table; turnouts move and lock; it cannot open with a turnout out of position or
 without indication, or with a section occupied, and closes when any of these is lost; it never reopens by itself.
 Release, guide, doors and aspects are in :mod:`.release`.
@@ -8,59 +8,21 @@ Each check runs on a fresh simulation (a :class:`~.probe.Probe`) and is recorded
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-
-from liansuo.interlocking.table import Route
 from liansuo.stations.schema import SectionRole
 
 from ..oracle.authority import Tracer
-from .probe import Context, Probe, against_running, open_route, other, prepare, route_line, turnout_groups
+from .probe import Probe, against_running, open_route, other, prepare, route_line, turnout_groups
+from .release import ReleaseChecks
+from .routecheck import RouteCheck, RouteResult
 
 _LINE = (SectionRole.approach, SectionRole.departure, SectionRole.block)
 SETTLE_S = 20.0  # long enough for any turnout move (the slowest machine 6.6 s, two batches) and a 64D acceptance
 
 
-@dataclass
-class RouteResult:
-    id: str
-    checks: int = 0
-    failures: int = 0
-    aspects_seen: set[str] = field(default_factory=set)
-    not_applicable: list[str] = field(default_factory=list)
-    order: tuple[str, ...] = ()  # the rule set's aspects, most permissive first: how aspects_seen is listed
-
-    def as_dict(self, aspects: tuple[str, ...]) -> dict[str, object]:
-        order = {a: i for i, a in enumerate(self.order)}
-        return {"id": self.id, "checks": self.checks, "failures": self.failures,
-                "aspects_table": list(aspects),
-                "aspects_seen": sorted(self.aspects_seen, key=lambda a: order.get(a, 99)),
-                "not_applicable": list(self.not_applicable)}
-
-
-class RouteTest:
+class RouteTest(RouteCheck):
     """All checks of one route; ``run()`` returns its tally."""
 
-    def __init__(self, ctx: Context, r: Route) -> None:
-        self.ctx = ctx
-        self.r = r
-        self.res = RouteResult(r.id, order=ctx.rules.aspects.by_rank)
-
-    def check(self, ok: bool, check: str, detail: str, p: Probe | None = None) -> bool:
-        self.res.checks += 1
-        if not ok:
-            self.res.failures += 1
-        return self.ctx.record(ok, check, self.r.id, detail, p)
-
-    def opened(self, p: Probe, check: str) -> bool:
-        """Open the route on a fresh probe; a failure to open is recorded under ``check``."""
-        ok = open_route(p, self.r)
-        if ok:
-            self.res.aspects_seen.add(p.aspect(self.r.signal))
-        return self.check(ok, check, f"signal {self.r.signal} did not open: {p.blocker(self.r)}", p)
-
     def run(self) -> RouteResult:
-        from .release import ReleaseChecks
-
         self.opens_from_the_other_positions()
         self.liaison()
         for t, pos in turnout_groups(self.ctx.station, self.r):

@@ -9,21 +9,17 @@ starting signal (which checks the same) is open.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
-if TYPE_CHECKING:
-    from ..sim import Simulation
+from .lineside import Lineside
 
 
-def platform_doors(sim: Simulation) -> None:
+def platform_doors(sim: Lineside) -> None:
     rules = sim.rules.driving
-    board = sim.interlocking.board
     for tr in sim.fleet.trains.values():
         ps = tr.platform_stop
         if ps is None:
             continue
         if ps.state == "stopped":
-            result = sim.interlocking.operator.doors(ps.platform, "open")
+            result = sim.doors(ps.platform, "open")
             if result.ok:
                 tr.train_doors_open = True
                 ps.state = "doors_open"
@@ -33,10 +29,10 @@ def platform_doors(sim: Simulation) -> None:
                 sim.log("train", f"train {tr.name}: doors stay closed: {result.message}")
                 ps.state = "closing"
         elif ps.state == "doors_open" and sim.t >= ps.until:
-            sim.interlocking.operator.doors(ps.platform, "close")
+            sim.doors(ps.platform, "close")
             tr.train_doors_open = False
             ps.state = "closing"
             sim.log("train", f"train {tr.name}: doors closing at {ps.platform}")
-        elif ps.state == "closing" and all(board.doors_safe(k) for k in ps.door_keys):
+        elif ps.state == "closing" and all(sim.view.doors_safe(k) for k in ps.door_keys):
             ps.state = "done"
             sim.log("train", f"train {tr.name}: doors closed and locked at {ps.platform}; ready to depart")

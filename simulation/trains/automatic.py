@@ -12,10 +12,8 @@ from several sources (each released only by its own source), and gives way at on
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
 
 from liansuo.interlocking.io import Result
-from liansuo.interlocking.state import RouteStage
 
 from .autoshunt import (
     ONE_STOP_WINDOW_M,
@@ -25,9 +23,7 @@ from .autoshunt import (
     permitted_speed_kmh,
 )
 from .fleet import Train
-
-if TYPE_CHECKING:
-    from ..sim import Simulation
+from .lineside import Lineside
 
 ONE_STOP_MARGIN_M = 1.0  # the front comes to a stand this far short of a one-stop point
 
@@ -53,7 +49,7 @@ class AutoController:
         return self.plan[self.step] if self.step < len(self.plan) else None
 
 
-def _next_signal(sim: Simulation, tr: Train) -> tuple[str | None, float]:
+def _next_signal(sim: Lineside, tr: Train) -> tuple[str | None, float]:
     """The next signal ahead that governs this shunting movement, and the distance to it."""
     names = sim.rules.aspects
     for dist, node, _ in sim.fleet.track.ahead(tr.pos, 2000.0):
@@ -63,22 +59,21 @@ def _next_signal(sim: Simulation, tr: Train) -> tuple[str | None, float]:
     return None, 1e9
 
 
-def inputs_for(sim: Simulation, tr: Train, ctl: AutoController) -> ShuntingInputs:
-    il = sim.interlocking
+def inputs_for(sim: Lineside, tr: Train, ctl: AutoController) -> ShuntingInputs:
+    view = sim.view
     sig, _dist = _next_signal(sim, tr)
-    rid = il.by_signal.get(sig) if sig else None
-    rs = il.routes.get(rid) if rid else None
-    locked = rs is not None and rs.stage in (RouteStage.locked, RouteStage.open, RouteStage.guide, RouteStage.closed,
-                                         RouteStage.in_use)
+    route = view.route_of(sig) if sig else None
+    rid = route.id if route is not None else None
+    locked = route is not None and route.state in ("locked", "open", "guide", "closed", "in_use")
     front_track, _ = sim.fleet.front(tr)
     front_section = sim.station.tracks[front_track].section if front_track in sim.station.tracks else ""
-    in_route = il.locks.section_locked(front_section)
+    in_route = bool(front_section) and view.section(front_section).locked
     if not in_route and front_section and sim.station.sections[front_section].role.value in ("spur", "station_track"):
         # on a depot or station track beyond the end of its route: the movement goes on under the shunting order up
         # to a safe distance before the next signal or buffer stop (the track holds no turnouts to lock)
         in_route = True
-    aspect = sim.aspect(sig) if sig else ""
     names = sim.rules.aspects
+    aspect = view.aspect(sig) if sig else ""
     plan_route = ctl.current
     return ShuntingInputs(
         authorised_onboard=ctl.authorised_onboard,
@@ -94,7 +89,7 @@ def inputs_for(sim: Simulation, tr: Train, ctl: AutoController) -> ShuntingInput
     )
 
 
-def _obstacle(sim: Simulation, tr: Train) -> float | None:
+def _obstacle(sim: Lineside, tr: Train) -> float | None:
     """Distance to the nearest wheelset of another train (or parked vehicle) on the way ahead."""
     others = [a for name, t in sim.fleet.trains.items() if name != tr.name
               for a in sim.fleet.track.axles(t.pos, t.consist.axle_offsets_m)]
@@ -110,7 +105,7 @@ def _obstacle(sim: Simulation, tr: Train) -> float | None:
     return best
 
 
-def attach(sim: Simulation, tr: Train, plan: list[str], flags: dict[str, bool] | None = None) -> Result:
+def attach(sim: Lineside, tr: Train, plan: list[str], flags: dict[str, bool] | None = None) -> Result:
     """Switch ``tr`` to automatic shunting (or, if it already is, update its plan and condition flags)."""
     ctl = tr.controller if isinstance(tr.controller, AutoController) else AutoController(plan)
     if plan:
@@ -129,7 +124,7 @@ def attach(sim: Simulation, tr: Train, plan: list[str], flags: dict[str, bool] |
     return Result.accept(f"train {tr.name} in automatic mode" + (f" with {len(plan)} planned routes" if plan else ""))
 
 
-def centre(sim: Simulation, tr: Train) -> None:
+def centre(sim: Lineside, tr: Train) -> None:
     """The centre's side: ask for the next planned route when the previous one has been run through."""
     ctl = tr.controller
     if not isinstance(ctl, AutoController):
@@ -137,7 +132,7 @@ def centre(sim: Simulation, tr: Train) -> None:
     rid = ctl.current
     if rid is None:
         return
-    state = sim.route_state(rid)
+    state = sim.view.route_state(rid)
     if ctl.requested == rid:
         if state == "released":
             route = sim.table.routes[rid]
@@ -155,7 +150,7 @@ def centre(sim: Simulation, tr: Train) -> None:
             sim.log("train", f"train {tr.name}: centre asked for {rid}")
 
 
-def auto_limit(sim: Simulation, tr: Train) -> tuple[float, str] | None:
+def auto_limit(sim: Lineside, tr: Train) -> tuple[float, str] | None:
     """The automatic controller's speed limit this step (m/s) and why; None to leave it to the signals."""
     ctl = tr.controller
     if not isinstance(ctl, AutoController):

@@ -3,18 +3,37 @@
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import TYPE_CHECKING
+from typing import Protocol
 
 from liansuo.interlocking.io import Result
+from liansuo.interlocking.table import InterlockingTable
 from liansuo.stations.schema import Direction
+from liansuo.stations.station import Station
 
+from ..language import Command
+from ..timeparse import parse_duration
 from .consist import make_consist
-from .fleet import MODES
+from .fleet import MODES, Fleet, Train
 
-if TYPE_CHECKING:
-    from ..sim import Simulation
 
-Handler = Callable[["Simulation", list[str]], Result]
+class Yard(Protocol):
+    """What the train commands need of the world: the station and its table, the fleet, where the wheelsets stand,
+    automatic shunting, and the log."""
+
+    @property
+    def station(self) -> Station: ...
+    @property
+    def table(self) -> InterlockingTable: ...
+    @property
+    def fleet(self) -> Fleet: ...
+    def update_axles(self) -> None:
+        """Tell the field where every wheelset stands."""
+    def attach_auto(self, train: Train, plan: list[str], flags: dict[str, bool] | None = None) -> Result:
+        """Switch ``train`` to automatic shunting."""
+    def log(self, kind: str, text: str) -> None: ...
+
+
+Handler = Callable[[Yard, list[str]], Result]
 
 USAGE = {
     "train": "train NAME at SECTION|TRACK [kind=freight|emu|shunter|trolley] [length=M] [axles=N] [vmax=KMH] "
@@ -33,7 +52,7 @@ USAGE = {
 _NUMBERS = {"length": "length", "axles": "axles", "vmax": "vmax"}
 
 
-def _train(sim: Simulation, args: list[str]) -> Result:
+def _train(sim: Yard, args: list[str]) -> Result:
     if len(args) == 2 and args[1] == "remove":
         if args[0] not in sim.fleet.trains:
             return Result.refuse(f"there is no train '{args[0]}'")
@@ -100,7 +119,7 @@ def _train(sim: Simulation, args: list[str]) -> Result:
                          f"facing {direction}, {mode})")
 
 
-def _facing(sim: Simulation, section: str) -> str:
+def _facing(sim: Yard, section: str) -> str:
     """The way the signals at the far end of ``section`` face (an approach faces its home signal); down if both."""
     ways = set()
     for sig in sim.station.model.signals:
@@ -110,7 +129,7 @@ def _facing(sim: Simulation, section: str) -> str:
     return ways.pop() if len(ways) == 1 else "down"
 
 
-def _named(sim: Simulation, args: list[str], usage: str, n: int) -> tuple[str, Result | None]:
+def _named(sim: Yard, args: list[str], usage: str, n: int) -> tuple[str, Result | None]:
     if len(args) != n:
         return "", Result.refuse(f"usage: {USAGE[usage]}")
     if args[0] not in sim.fleet.trains:
@@ -118,7 +137,7 @@ def _named(sim: Simulation, args: list[str], usage: str, n: int) -> tuple[str, R
     return args[0], None
 
 
-def _drive(sim: Simulation, args: list[str]) -> Result:
+def _drive(sim: Yard, args: list[str]) -> Result:
     name, bad = _named(sim, args, "drive", 2)
     if bad:
         return bad
@@ -139,7 +158,7 @@ def _drive(sim: Simulation, args: list[str]) -> Result:
     return Result.accept(f"train {name}: manual, {kmh:g} km/h")
 
 
-def _stop(sim: Simulation, args: list[str]) -> Result:
+def _stop(sim: Yard, args: list[str]) -> Result:
     name, bad = _named(sim, args, "stop", 1)
     if bad:
         return bad
@@ -150,7 +169,7 @@ def _stop(sim: Simulation, args: list[str]) -> Result:
     return Result.accept(f"train {name} braking to a stop")
 
 
-def _auto(sim: Simulation, args: list[str]) -> Result:
+def _auto(sim: Yard, args: list[str]) -> Result:
     if not args:
         return Result.refuse(f"usage: {USAGE['auto']}")
     name = args[0]
@@ -173,9 +192,7 @@ def _auto(sim: Simulation, args: list[str]) -> Result:
     return sim.attach_auto(sim.fleet.trains[name], plan, flags)
 
 
-def _slip(sim: Simulation, args: list[str]) -> Result:
-    from ..timeparse import parse_duration
-
+def _slip(sim: Yard, args: list[str]) -> Result:
     name, bad = _named(sim, args, "slip", 3)
     if bad:
         return bad
@@ -193,7 +210,7 @@ def _slip(sim: Simulation, args: list[str]) -> Result:
     return Result.accept(f"train {name}: wheels {what} {abs(ratio) * 100:g} % for {seconds:g} s")
 
 
-def _estop(sim: Simulation, args: list[str]) -> Result:
+def _estop(sim: Yard, args: list[str]) -> Result:
     name, bad = _named(sim, args, "estop", 2)
     if bad:
         return bad
@@ -203,7 +220,7 @@ def _estop(sim: Simulation, args: list[str]) -> Result:
     return Result.accept(f"train {name}: emergency stop from {args[1]}")
 
 
-def _estop_release(sim: Simulation, args: list[str]) -> Result:
+def _estop_release(sim: Yard, args: list[str]) -> Result:
     if len(args) not in (2, 3):
         return Result.refuse(f"usage: {USAGE['estop-release']}")
     name, source = args[0], args[1]
@@ -221,7 +238,7 @@ def _estop_release(sim: Simulation, args: list[str]) -> Result:
     return Result.accept(f"train {name}: emergency stop from {source} released")
 
 
-def _reverse(sim: Simulation, args: list[str]) -> Result:
+def _reverse(sim: Yard, args: list[str]) -> Result:
     name, bad = _named(sim, args, "reverse", 1)
     if bad:
         return bad
@@ -233,6 +250,7 @@ def _reverse(sim: Simulation, args: list[str]) -> Result:
     return Result.accept(f"train {name} now faces {tr.direction.value}")
 
 
-TRAIN_COMMANDS: dict[str, Handler] = {"train": _train, "drive": _drive, "stop": _stop, "auto": _auto,
-                                      "reverse": _reverse, "estop": _estop, "estop-release": _estop_release,
-                                      "slip": _slip}
+_HANDLERS: dict[str, Handler] = {"train": _train, "drive": _drive, "stop": _stop, "auto": _auto,
+                                  "reverse": _reverse, "estop": _estop, "estop-release": _estop_release, "slip": _slip}
+
+TRAIN_COMMANDS: tuple[Command[Yard], ...] = tuple(Command(name, USAGE[name], h) for name, h in _HANDLERS.items())

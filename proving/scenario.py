@@ -18,12 +18,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
+from liansuo.simulation.sim import LANGUAGE, Simulation
+from liansuo.simulation.timeparse import parse_duration
 from liansuo.stations.loader import load
 from liansuo.stations.source import Diagnostic, StationError, read_file
-
-from .commands import read_steps
-from .sim import Simulation
-from .timeparse import parse_duration
 
 
 @dataclass
@@ -54,7 +52,7 @@ def parse_scenario(path: Path) -> Scenario:
         errors.append(src.diagnostic(("steps",) if "steps" in data else (), "'steps:' must be a list of commands",
                                      ""))
     else:
-        steps = read_steps(src, ("steps",), steps_raw, errors)
+        steps = LANGUAGE.read_steps(src, ("steps",), steps_raw, errors)
     until = None
     if "until" in data:
         try:
@@ -84,7 +82,7 @@ def run_scenario(sc: Scenario, until_s: float | None = None, out: list[str] | No
             out.append(text)
 
     def flush() -> None:
-        il_events, world = list(sim.interlocking.events), list(sim.events)
+        il_events, world = list(sim.view.events()), list(sim.events)
         new = sorted(il_events[seen[0]:] + world[seen[1]:], key=lambda e: e.t)
         seen[0], seen[1] = len(il_events), len(world)
         for e in new:

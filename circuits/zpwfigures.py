@@ -1,17 +1,13 @@
-"""``liansuo zpw STATION``: the ZPW-2000A figures of every section (adjustment, worst shunt residual, minimum cab
-current), optionally with compensation-capacitor faults. The model is ``circuits.zpw2000a``; see docs/zpw2000a.md."""
+"""The ZPW-2000A figures of a station's sections (adjustment, worst shunt residual, minimum cab current), optionally
+with compensation-capacitor faults, as rows, text and CSV: what ``liansuo zpw`` prints (:mod:`.zpwcli`). The model
+is :mod:`.zpw2000a`; see docs/zpw2000a.md."""
 
 from __future__ import annotations
 
-import argparse
 import csv
-import json
-import sys
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from typing import Any
 
-from liansuo.stations.loader import load
-from liansuo.stations.source import StationError
 from liansuo.stations.station import Station
 
 COLUMNS = ("id", "carrier", "length_m", "capacitors", "adjustment_mV", "max_shunt_residual_mV",
@@ -43,7 +39,7 @@ def zpw_sections(station: Station) -> list[str]:
 
 def collect_faults(station: Station, specs: Sequence[str]) -> dict[str, dict[int, str]]:
     """Every --fault, checked against the station: section -> {capacitor number: mode}."""
-    from liansuo.circuits.zpw2000a import capacitor_positions
+    from .zpw2000a import capacitor_positions  # numpy loads when figures are asked for, not with the command line
 
     zpw = set(zpw_sections(station))
     out: dict[str, dict[int, str]] = {}
@@ -63,7 +59,7 @@ def collect_faults(station: Station, specs: Sequence[str]) -> dict[str, dict[int
 
 def section_rows(station: Station, faults: dict[str, dict[int, str]] | None = None) -> list[dict[str, Any]]:
     """One row per ZPW-2000A section, in file order, with the fault applied where one is given."""
-    from liansuo.circuits.zpw2000a import ZpwFaults, fault_label, section_circuit
+    from .zpw2000a import ZpwFaults, fault_label, section_circuit
 
     rows = []
     for sid in zpw_sections(station):
@@ -94,7 +90,7 @@ def _line(values: Sequence[object], widths: Sequence[int]) -> str:
 
 
 def as_text(station: Station, rows: list[dict[str, Any]]) -> str:
-    from liansuo.circuits.zpw2000a import DEFAULT_PARAMS as P
+    from .zpw2000a import DEFAULT_PARAMS as P
 
     if not rows:
         return f"{station.id} has no ZPW-2000A sections"
@@ -122,39 +118,3 @@ def write_csv(path: str, rows: list[dict[str, Any]]) -> None:
         writer.writeheader()
         for r in rows:
             writer.writerow({**r, "fault": r["fault"] or ""})
-
-
-def cmd_zpw(args: argparse.Namespace) -> int:
-    try:
-        station = load(args.station)
-    except StationError as exc:
-        for d in exc.diagnostics:
-            print(d, file=sys.stderr)
-        return 1
-    try:
-        faults = collect_faults(station, args.fault)
-    except FaultSpecError as exc:
-        print(f"liansuo zpw: {exc}", file=sys.stderr)
-        return 2
-    rows = section_rows(station, faults)
-    if args.csv:
-        try:
-            write_csv(args.csv, rows)
-        except OSError as exc:
-            print(f"liansuo zpw: cannot write {args.csv}: {exc.strerror}", file=sys.stderr)
-            return 2
-    if args.format == "json":
-        print(json.dumps({"station": station.id, "sections": rows}, ensure_ascii=False, indent=2))
-    else:
-        print(as_text(station, rows))
-    return 0
-
-
-def register(add: Callable[[str, Callable[[argparse.Namespace], int], str], argparse.ArgumentParser]) -> None:
-    """Add the ``zpw`` subcommand through the CLI's ``add(name, handler, help)``."""
-    sp = add("zpw", cmd_zpw, "ZPW-2000A section figures: adjustment, shunt residual, cab current (with faults)")
-    sp.add_argument("station", help="bundled station name or path")
-    sp.add_argument("--fault", action="append", default=[], metavar=FAULT_FORM,
-                    help="a compensation-capacitor fault (repeatable); capacitors are numbered from the lower end")
-    sp.add_argument("--format", choices=("text", "json"), default="text")
-    sp.add_argument("--csv", metavar="FILE", help="also write the table as CSV to FILE")

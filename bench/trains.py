@@ -18,9 +18,9 @@ from dataclasses import dataclass
 from typing import Any
 
 from liansuo.interlocking.table import InterlockingTable, Route
+from liansuo.simulation.sim import Simulation
+from liansuo.simulation.trains.sumo import sumo_installed
 from liansuo.stations.station import Station
-
-from .sim import Simulation
 
 TRAIN_SLOTS = 10
 TRAIN_LENGTH_M = 300.0
@@ -182,8 +182,6 @@ def measure_trains(station: Station, table: InterlockingTable, engine: str, cycl
 def run_trains(station: Station, table: InterlockingTable, *, cycles: int, sumo_cycles: int,
                slots: int = TRAIN_SLOTS) -> dict[str, Any]:
     """``realtime_factor_trains`` (kinematic), ``realtime_factor_trains_sumo`` and the ratio, side by side."""
-    from .trains.sumo import sumo_installed
-
     kin = measure_trains(station, table, "kinematic", cycles, slots)
     out: dict[str, Any] = {"station": station.id, "trains": kin["slots"], "kinematic": kin,
                            "realtime_factor_trains": kin["realtime_factor"]}

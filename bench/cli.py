@@ -1,0 +1,20 @@
+"""``liansuo bench [--quick] [--format json|text]``."""
+
+from __future__ import annotations
+
+import argparse
+from collections.abc import Callable
+
+Add = Callable[..., argparse.ArgumentParser]
+
+
+def cmd_bench(args: argparse.Namespace) -> int:
+    from .report import main  # the benchmark loads the whole simulation: only when it runs
+
+    return main(quick=args.quick, fmt=args.format)
+
+
+def register(add: Add) -> None:
+    sp = add("bench", cmd_bench, "benchmark table building and the interlocking cycle (hub and jiaopei)")
+    sp.add_argument("--quick", action="store_true", help="fewer cycles (under a minute)")
+    sp.add_argument("--format", choices=("json", "text"), default="json")

@@ -1,0 +1,167 @@
+"""The whole benchmark: how much to run, every figure of every station, the targets met or missed, and the report
+as JSON or text (``liansuo bench``)."""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+from dataclasses import dataclass
+from typing import Any
+
+from liansuo.interlocking.table import build_table
+from liansuo.stations.hubgen import generate_hub
+from liansuo.stations.loader import load_text
+
+from .busy import BUSY_ROUTES
+from .machine import machine
+from .station import measure
+from .trains import TARGET_TRAINS, run_trains, trains_text
+from .zpw import ZPW_TARGET_CONFIGS_PER_S, measure_zpw
+
+HUB_TURNOUTS = 200
+HUB_TRACKS = 80
+
+# (figure, comparison, target) per station; reported with the measured value, never asserted
+TARGETS: dict[str, list[tuple[str, str, float]]] = {
+    "hub": [("table_build_s", "<=", 5.0), ("cycle_us_busy", "<=", 1000.0), ("realtime_factor", ">=", 250.0)],
+    "jiaopei": [("realtime_factor", ">=", 5000.0)],
+}
+
+
+@dataclass(frozen=True)
+class Sizes:
+    """How much to run: the full benchmark, ``--quick``, or a tiny run for the test suite."""
+
+    hub_turnouts: int = HUB_TURNOUTS
+    hub_tracks: int = HUB_TRACKS
+    idle_cycles: int = 8000
+    busy_cycles: int = 16000
+    small_factor: int = 5  # jiaopei runs this many times more cycles (each is much cheaper)
+    busy_routes: int = BUSY_ROUTES
+    warmup_limit: int = 2400  # cycles allowed for the busy routes to be set and opened once
+    zpw_repeats: int = 10  # vectorised ZPW-2000A sweeps timed
+    train_cycles: int = 4800  # trains moving on the hub, each engine (trains.py); 0 skips it
+    train_slots: int = 10
+
+    @staticmethod
+    def quick() -> Sizes:
+        return Sizes(idle_cycles=1000, busy_cycles=2400, zpw_repeats=3, train_cycles=1200)
+
+    @staticmethod
+    def tiny() -> Sizes:
+        return Sizes(hub_turnouts=20, hub_tracks=8, idle_cycles=20, busy_cycles=120, small_factor=1,
+                     warmup_limit=400, zpw_repeats=1, train_cycles=240, train_slots=2)
+
+
+def _check_targets(results: dict[str, dict[str, Any]]) -> list[dict[str, Any]]:
+    checks = []
+    for key, targets in TARGETS.items():
+        res = results.get(key)
+        if res is None:
+            continue
+        for figure, op, target in targets:
+            value = float(res[figure])
+            met = value <= target if op == "<=" else value >= target
+            checks.append({"station": res["station"], "figure": figure, "target": f"{op} {target:g}",
+                           "value": value, "met": met})
+    return checks
+
+
+def run_bench(sizes: Sizes | None = None, *, quick: bool = False, stations: tuple[str, ...] = ("jiaopei", "hub"),
+              ) -> dict[str, Any]:
+    """Run the benchmark and return every figure (see the module docstring and docs/benchmark.md)."""
+    sizes = sizes or (Sizes.quick() if quick else Sizes())
+    start = time.perf_counter()
+    results: dict[str, dict[str, Any]] = {}
+    for key in stations:  # the small station first, so its peak memory is its own
+        if key == "hub":
+            text = generate_hub(sizes.hub_turnouts, sizes.hub_tracks)
+            results[key] = measure(text, label=f"hub{sizes.hub_turnouts}", text=True,
+                                   idle_cycles=sizes.idle_cycles, busy_cycles=sizes.busy_cycles,
+                                   routes_limit=sizes.busy_routes, warmup_limit=sizes.warmup_limit)
+            results[key]["hub_tracks"] = sizes.hub_tracks
+        else:
+            results[key] = measure(key, label=key, text=False, idle_cycles=sizes.idle_cycles * sizes.small_factor,
+                                   busy_cycles=sizes.busy_cycles * sizes.small_factor,
+                                   routes_limit=sizes.busy_routes, warmup_limit=sizes.warmup_limit)
+    zpw = measure_zpw(sizes.zpw_repeats)
+    trains = _trains(sizes) if "hub" in stations and sizes.train_cycles > 0 else None
+    targets = _check_targets(results)
+    targets.append({"station": "zpw", "figure": "zpw_configs_per_s", "target": f">= {ZPW_TARGET_CONFIGS_PER_S:g}",
+                    "value": zpw["zpw_configs_per_s"], "met": zpw["zpw_configs_per_s"] >= ZPW_TARGET_CONFIGS_PER_S})
+    if trains is not None:
+        value = trains["realtime_factor_trains"]
+        targets.append({"station": trains["station"], "figure": "realtime_factor_trains",
+                        "target": f">= {TARGET_TRAINS:g}", "value": value, "met": value >= TARGET_TRAINS})
+    return {
+        "benchmark": "liansuo bench",
+        "mode": "quick" if quick else ("custom" if sizes != Sizes() else "full"),
+        "machine": machine(),
+        "cycle_s": 0.25,
+        "results": results,
+        "zpw": zpw,
+        **({"trains": trains} if trains is not None else {}),
+        "targets": targets,
+        "total_s": round(time.perf_counter() - start, 2),
+    }
+
+
+def _trains(sizes: Sizes) -> dict[str, Any]:
+    """Trains moving on the hub: the kinematic engine and SUMO side by side (:mod:`.trains`)."""
+    station = load_text(generate_hub(sizes.hub_turnouts, sizes.hub_tracks), f"<hub{sizes.hub_turnouts}>")
+    return run_trains(station, build_table(station), cycles=sizes.train_cycles, sumo_cycles=sizes.train_cycles,
+                      slots=sizes.train_slots)
+
+
+def all_finite(value: object) -> bool:
+    """True when every number in a (nested) benchmark result is finite."""
+    if isinstance(value, dict):
+        return all(all_finite(v) for v in value.values())
+    if isinstance(value, list):
+        return all(all_finite(v) for v in value)
+    if isinstance(value, float):
+        return math.isfinite(value)
+    return True
+
+
+# ---- output --------------------------------------------------------------------------------------------------------
+_TEXT_ROWS = [
+    ("turnouts", "turnouts", "{:d}"), ("sections", "sections", "{:d}"), ("routes", "routes", "{:d}"),
+    ("load_s", "load (s)", "{:.3f}"), ("table_build_s", "table build (s)", "{:.3f}"),
+    ("cycle_us_idle", "cycle idle (us)", "{:.1f}"), ("cycle_us_busy", "cycle busy (us)", "{:.1f}"),
+    ("circuit_us_busy", "  of it circuits (us)", "{:.1f}"),
+    ("busy_routes", "busy routes", "{:d}"), ("realtime_factor", "real-time factor (busy)", "{:.0f}x"),
+    ("realtime_factor_idle", "real-time factor (idle)", "{:.0f}x"), ("busy_traversals", "traversals", "{:d}"),
+    ("busy_stalls", "stalls", "{:d}"), ("peak_memory_mb", "peak RSS (MB)", "{:.1f}"),
+]
+
+
+def as_text(report: dict[str, Any]) -> str:
+    m = report["machine"]
+    lines = [f"liansuo bench ({report['mode']}) on {m['cpu_model'] or m['processor'] or m['machine']}, "
+             f"{m['cpu_count']} CPUs, Python {m['python']}"]
+    results = report["results"]
+    keys = list(results)
+    lines.append(f"{'':26}" + "".join(f"{results[k]['station']:>14}" for k in keys))
+    for field, title, fmt in _TEXT_ROWS:
+        lines.append(f"{title:26}" + "".join(f"{fmt.format(results[k][field]):>14}" for k in keys))
+    z = report.get("zpw")
+    if z:
+        lines.append(f"{'zpw configs/s':26}{z['zpw_configs_per_s']:>14.0f}  ({z['configurations']} per sweep of "
+                     f"{z['sweep_s'] * 1000:.1f} ms; evaluate {z['evaluate_us_one_shunt']:.0f} us, 64-axle train "
+                     f"{z['evaluate_us_train64']:.0f} us)")
+    if report.get("trains"):
+        lines += trains_text(report["trains"])
+    lines.append("targets:")
+    for t in report["targets"]:
+        lines.append(f"  {t['station']:10} {t['figure']:16} {t['target']:>8}  measured {t['value']:g}  "
+                     f"{'met' if t['met'] else 'MISSED'}")
+    lines.append(f"total {report['total_s']:.1f} s")
+    return "\n".join(lines)
+
+
+def main(quick: bool = False, fmt: str = "json") -> int:
+    report = run_bench(quick=quick)
+    print(json.dumps(report, indent=2) if fmt == "json" else as_text(report))
+    return 0

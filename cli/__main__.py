@@ -1,0 +1,7 @@
+"""``python -m liansuo.cli``: the same as the ``liansuo`` command."""
+
+import sys
+
+from .main import main
+
+sys.exit(main())

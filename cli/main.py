@@ -1,0 +1,67 @@
+"""The ``liansuo`` command: every subcommand, registered from the rooms' own ``register(add)`` functions.
+
+The list is explicit: the package is one, so there is no plugin group to search. A room's register function
+imports only what its arguments need; what a subcommand runs is loaded when it runs, so ``liansuo check`` never
+loads the console (Textual) and the console never slows the other subcommands.
+"""
+
+from __future__ import annotations
+
+import argparse
+from collections.abc import Callable, Sequence
+
+from liansuo.bench import cli as bench
+from liansuo.circuits import zpwcli
+from liansuo.interlocking import cli as interlocking
+from liansuo.proving import cli as proving
+from liansuo.proving import mutation, soakcli
+from liansuo.proving.verify import cli as verify
+from liansuo.stations import cli as stations
+from liansuo.tui import cli as tui
+
+Handler = Callable[[argparse.Namespace], int]
+Add = Callable[[str, Handler, str], argparse.ArgumentParser]
+
+# in the order of the help: the station, its table and track circuits, proving it, timing it, the console
+REGISTER: tuple[Callable[[Add], None], ...] = (
+    stations.register,  # stations, check, schema
+    interlocking.register,  # table
+    zpwcli.register,  # zpw
+    proving.register_run,  # run
+    proving.register,  # test
+    verify.register,  # verify
+    soakcli.register,  # soak
+    mutation.register,  # mutate
+    bench.register,  # bench
+    tui.register,  # tui
+    tui.register_replay,  # replay
+)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="liansuo", description="Station signalling and interlocking simulator (联锁)")
+    sub = p.add_subparsers(dest="command", metavar="COMMAND")
+
+    def add(name: str, handler: Handler, help_: str) -> argparse.ArgumentParser:
+        sp = sub.add_parser(name, help=help_, description=help_)
+        sp.set_defaults(handler=handler)
+        return sp
+
+    for register in REGISTER:
+        register(add)
+    return p
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    handler: Handler | None = getattr(args, "handler", None)
+    if handler is None:
+        parser.print_help()
+        return 2
+    try:
+        return handler(args)
+    except BrokenPipeError:  # e.g. piped into head
+        return 0
+    except KeyboardInterrupt:
+        return 130

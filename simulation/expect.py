@@ -1,0 +1,100 @@
+"""The scripts' checks, ``expect signal|route|turnout|section|refused|accepted|alarm|no-alarm|block-line|code ...``.
+
+Each compares what the world shows now (through its query API) with what the script expects and says what it saw.
+"""
+
+from __future__ import annotations
+
+from liansuo.interlocking.io import Result
+
+from .language import Command
+from .world import World
+
+USAGE = "expect signal|route|turnout|section|refused|accepted|alarm|no-alarm|block-line|code|odometry ..."
+
+
+def _expect(sim: World, args: list[str]) -> Result:
+    if not args:
+        return Result.refuse(f"usage: {USAGE}")
+    what, rest = args[0], args[1:]
+    st = sim.station
+    if what == "signal" and len(rest) == 2:
+        sig, want = rest
+        if sig not in st.signals:
+            return Result.refuse(f"there is no signal '{sig}'")
+        got = sim.aspect(sig)
+        return Result(got == want, f"signal {sig} shows {got}" + ("" if got == want else f", expected {want}"))
+    if what == "route" and len(rest) in (2, 3):
+        if len(rest) == 2:
+            route_id, want = rest
+        else:
+            route_id, want = f"{rest[0]}-{rest[1]}", rest[2]
+        if route_id not in sim.table.routes and not any(r.startswith(route_id + "(") for r in sim.table.routes):
+            return Result.refuse(f"there is no route {route_id}")
+        got = sim.route_state(route_id)
+        ok = got == want or (want == "locked" and got in ("locked", "open", "guide", "closed", "in_use", "time_release")
+                             ) or (want == "open" and got == "guide")
+        return Result(ok, f"route {route_id} is {got}" + ("" if ok else f", expected {want}"))
+    if what == "turnout" and len(rest) in (2, 3):
+        t, want = rest[0], rest[1]
+        if t not in st.turnouts:
+            return Result.refuse(f"there is no turnout '{t}'")
+        pos, locked = sim.turnout_state(t)
+        ok = (pos or "none") == want and (len(rest) == 2 or (rest[2] == "locked") == locked)
+        state = f"turnout {t} is {pos or 'without indication'}{' and locked' if locked else ''}"
+        return Result(ok, state + ("" if ok else f", expected {' '.join(rest[1:])}"))
+    if what == "section" and len(rest) == 2:
+        s, want = rest
+        if s not in st.sections:
+            return Result.refuse(f"there is no section '{s}'")
+        got = sim.section_state(s)
+        return Result(got == want, f"section {s} is {got}" + ("" if got == want else f", expected {want}"))
+    if what in ("refused", "accepted"):
+        last = sim.last_result
+        text = " ".join(rest)
+        if last is None:
+            return Result.refuse("no command before this expect")
+        if what == "refused":
+            ok = not last.ok and _mentions(last.message, text)
+            return Result(ok, f"the command was {'refused' if not last.ok else 'accepted'}: {last.message}")
+        ok = last.ok and _mentions(last.message, text)
+        return Result(ok, f"the command was {'accepted' if last.ok else 'refused'}: {last.message}")
+    if what in ("alarm", "no-alarm"):
+        text = " ".join(rest).lower()
+        hits = [a for a in sim.alarm_texts() if _mentions(a, text)]
+        ok = bool(hits) if what == "alarm" else not hits
+        shown = "; ".join(sim.alarm_texts()) or "none"
+        return Result(ok, f"active alarms: {shown}")
+    if what == "block-line" and len(rest) == 2:
+        line = sim.view.block_line(rest[0])
+        if line is None:
+            return Result.refuse(f"there is no 64D block line '{rest[0]}'")
+        return Result(line == rest[1], f"block line {rest[0]} is {line}")
+    if what == "odometry" and len(rest) == 3 and rest[1] == "within":
+        tr = sim.fleet.trains.get(rest[0])
+        if tr is None:
+            return Result.refuse(f"there is no train '{rest[0]}'")
+        try:
+            bound = float(rest[2].removesuffix("m"))
+        except ValueError:
+            return Result.refuse("expect odometry NAME within METRES")
+        err = tr.odometer.error_m(tr.travelled_m)
+        return Result(abs(err) <= bound, f"odometry of {rest[0]} is {err:+.2f} m off" +
+                      ("" if abs(err) <= bound else f", expected within {bound:g} m"))
+    if what == "code" and len(rest) == 2:
+        s, want = rest
+        shown = sim.view.cab_code(s) or "none"
+        return Result(shown == want, f"section {s} carries code {shown}" + ("" if shown == want else
+                                                                              f", expected {want}"))
+    return Result.refuse(f"usage: {USAGE}")
+
+
+def _mentions(message: str, text: str) -> bool:
+    """Does ``message`` contain ``text``, ignoring case and quotes? A script's words lose their quotes when the line
+    is read (``expect refused there is no train 'T9'``), the interlocking's messages keep theirs."""
+    def plain(s: str) -> str:
+        return s.replace("'", "").replace('"', "").lower()
+    return plain(text) in plain(message)
+
+
+EXPECT: Command[World] = Command("expect", USAGE, _expect)

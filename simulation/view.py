@@ -1,0 +1,223 @@
+"""The query API: what the trains, the console and every other front end read of the interlocking, as typed records.
+
+The interlocking's inner state (route states, the lock ledger, turnout supervision, alarm keys) is read here and
+nowhere else in the world or above it, so a change inside the interlocking is adapted in this one module. Its relay
+interface (:class:`~interlocking.io.RelayBoard` in, :class:`~interlocking.io.Outputs` out) is the contract with the
+field and is handed on as it is.
+
+Records are frozen: each is the state of one element at the moment it was asked for. :class:`InterlockingView` is the
+live reader the world keeps (``World.view``), renewed when the interlocking restarts.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+from liansuo.interlocking.cbi import Interlocking
+from liansuo.interlocking.io import Event, Outputs, RelayBoard
+from liansuo.interlocking.locks import Hold
+from liansuo.interlocking.state import RouteStage, RouteState
+
+# alarm kinds of the interlocking that concern a signal (the console marks its name)
+SIGNAL_ALARMS = frozenset({"closed", "lamp", "red", "filament", "flasher"})
+
+
+@dataclass(frozen=True)
+class RouteView:
+    """A route the interlocking holds (selected, locked, open, in use or counting down a release)."""
+
+    id: str
+    signal: str
+    kind: str  # "train" or "shunt"
+    state: str  # setting, locked, open, guide, closed, in_use, time_release: the words of 'expect route'
+    sections: tuple[str, ...]  # the sections it locks, with those it runs on over
+    guide: bool  # showing the guide aspect (HB, 引导)
+    release_at: float | None  # when a manual time release (总人解) or fault-release delay completes
+
+
+@dataclass(frozen=True)
+class SignalView:
+    id: str
+    aspect: str  # the commanded aspect code (L, U, H, B, A ...), '' if none
+    route: str | None  # the route whose signal this is, while one is set
+    closed: bool  # closed abnormally (the reason is in the alarm)
+    lamp_dark: bool  # a lamp of the commanded aspect is dark
+    red_dark: bool  # the stop lamp is dark (both filaments)
+    filament: bool  # a main filament broken, the lamp on its backup
+    flasher: bool  # the USU flasher failed
+
+    @property
+    def alarmed(self) -> bool:
+        return self.closed or self.lamp_dark or self.red_dark or self.filament or self.flasher
+
+
+@dataclass(frozen=True)
+class TurnoutView:
+    id: str
+    position: str | None  # indicated position, None without indication
+    locked: bool  # may not move: a route, overlap, single lock, guide total lock, power-up, or a locked section
+    why: str  # why it may not move, in a signaller's words ('' when it may)
+    mark: str  # what the console marks: 'blocked' (单封), 'locked' (单锁), 'guide' (引导总锁闭) or ''
+    moving: bool  # being driven
+
+    @property
+    def indicated(self) -> bool:
+        return self.position is not None
+
+
+@dataclass(frozen=True)
+class SectionView:
+    id: str
+    occupied: bool  # its track relay is down (a train, a fault, or nothing reported yet)
+    locked: bool  # locked by a route, an overlap, a fouling check or the power-up lock
+
+    @property
+    def state(self) -> str:
+        """'occupied', 'locked' or 'free', as the console paints it and 'expect section' checks it."""
+        return "occupied" if self.occupied else "locked" if self.locked else "free"
+
+
+@dataclass(frozen=True)
+class AlarmView:
+    """An active alarm, of the interlocking or of the world (a derailment, a turnout squeezed by a train)."""
+
+    key: str  # what acknowledges it
+    kind: str  # closed, lamp, red, filament, flasher, move, squeeze, spad, ... or 'world'
+    element: str  # the signal or turnout it concerns ('' for the world's)
+    text: str
+    t: float | None  # when it was raised; None where the world keeps no time
+
+
+@dataclass(frozen=True)
+class TrainView:
+    """What a front end shows of a train: its name, the sections its wheelsets shunt, speed and direction."""
+
+    name: str
+    sections: tuple[str, ...]
+    speed_kmh: float
+    direction: str  # "down" or "up"
+    mode: str  # "manual", "signal", "auto"
+    head_track: str
+    head_m: float  # position of the leading wheelset along the line
+
+
+class InterlockingView:
+    """Typed questions to one interlocking."""
+
+    def __init__(self, interlocking: Interlocking) -> None:
+        self._il = interlocking
+
+    # ---- the relay interface ----------------------------------------------------------------------------------
+    @property
+    def inputs(self) -> RelayBoard:
+        """The relay states the field reports (what the interlocking sees)."""
+        return self._il.board
+
+    @property
+    def outputs(self) -> Outputs:
+        """What the interlocking drives: turnouts, aspects, doors, cab codes, line pulses."""
+        return self._il.out
+
+    # ---- signals ------------------------------------------------------------------------------------------------
+    def aspect(self, signal: str) -> str:
+        return self._il.out.signals.get(signal, "")
+
+    def aspects(self) -> Mapping[str, str]:
+        """Every signal's commanded aspect (a live mapping: it follows the interlocking)."""
+        return self._il.out.signals
+
+    def signal(self, signal: str) -> SignalView:
+        return self._signal(signal, self._signal_alarms().get(signal, set()))
+
+    def signals(self) -> tuple[SignalView, ...]:
+        """Every signal, in station order."""
+        alarms = self._signal_alarms()
+        return tuple(self._signal(s, alarms.get(s, set())) for s in self._il.core.signals)
+
+    def _signal(self, signal: str, kinds: set[str]) -> SignalView:
+        return SignalView(signal, self.aspect(signal), self._il.by_signal.get(signal), "closed" in kinds,
+                          "lamp" in kinds, "red" in kinds, "filament" in kinds, "flasher" in kinds)
+
+    def _signal_alarms(self) -> dict[str, set[str]]:
+        out: dict[str, set[str]] = {}
+        for a in self.alarms():
+            if a.kind in SIGNAL_ALARMS:
+                out.setdefault(a.element, set()).add(a.kind)
+        return out
+
+    # ---- routes -------------------------------------------------------------------------------------------------
+    def route(self, route_id: str) -> RouteView | None:
+        rs = self._il.routes.get(route_id)
+        return None if rs is None else _route(rs)
+
+    def route_of(self, signal: str) -> RouteView | None:
+        """The route set from ``signal``, if any."""
+        rid = self._il.by_signal.get(signal)
+        return None if rid is None else self.route(rid)
+
+    def routes(self) -> tuple[RouteView, ...]:
+        """Every route the interlocking holds, in order of selection."""
+        return tuple(_route(rs) for rs in self._il.routes.values())
+
+    def route_state(self, route_id: str) -> str:
+        """The route's state word, 'released' when the interlocking holds no such route."""
+        rs = self._il.routes.get(route_id)
+        return "released" if rs is None else rs.stage.value
+
+    # ---- turnouts and sections ----------------------------------------------------------------------------------
+    def turnout(self, turnout: str) -> TurnoutView:
+        il = self._il
+        locks = il.locks.turnout_locks(turnout)
+        holds = {lk.hold for lk, _, _ in locks}
+        mark = ("blocked" if turnout in il.locks.blocked else "locked" if Hold.single in holds
+                else "guide" if Hold.guide in holds else "")
+        return TurnoutView(turnout, il.board.indication(turnout), bool(locks),
+                           il.locks.why_turnout(turnout) if locks else "", mark, turnout in il.core.moving)
+
+    def turnouts(self) -> tuple[TurnoutView, ...]:
+        """Every turnout, in station order."""
+        return tuple(self.turnout(t) for t in self._il.core.turnouts)
+
+    def section(self, section: str) -> SectionView:
+        return SectionView(section, not self._il.board.clear(section), self._il.locks.section_locked(section))
+
+    def sections(self, ids: Sequence[str]) -> tuple[SectionView, ...]:
+        return tuple(self.section(s) for s in ids)
+
+    # ---- doors, lines, codes ------------------------------------------------------------------------------------
+    def doors_safe(self, key: str) -> bool:
+        """The screen doors ``platform:side`` are proven closed and locked (PDKJ), or bypassed (PDQCJ)."""
+        return self._il.board.doors_safe(key)
+
+    def line_outbound(self, link: str) -> bool:
+        """The direction circuit of an automatic line is set for our departures (改方)."""
+        return self._il.out.line_direction.get(link) == "outbound"
+
+    def block_line(self, link: str) -> str | None:
+        """The state of a 64D block line (idle, requested, ...), None if there is no such line."""
+        bl = self._il.core.links.get(link)
+        return None if bl is None else bl.state.value
+
+    def cab_code(self, section: str) -> str | None:
+        """The low-frequency code a coded section carries, None when it carries none."""
+        return self._il.out.cab_codes.get(section)
+
+    # ---- alarms and events --------------------------------------------------------------------------------------
+    def alarms(self) -> tuple[AlarmView, ...]:
+        """The interlocking's active alarms, oldest first."""
+        out = []
+        for a in self._il.alarms.values():
+            kind, _, rest = a.key.partition(":")  # the interlocking's keys: KIND:ELEMENT[:DETAIL]
+            out.append(AlarmView(a.key, kind, rest.partition(":")[0], a.text, a.t))
+        return tuple(out)
+
+    def events(self) -> Sequence[Event]:
+        """The interlocking's event log (a live sequence, newest last)."""
+        return self._il.events
+
+
+def _route(rs: RouteState) -> RouteView:
+    r = rs.route
+    return RouteView(r.id, r.signal, r.kind, rs.stage.value, rs.sections, rs.stage is RouteStage.guide,
+                     rs.release_at)

@@ -1,0 +1,180 @@
+"""The world around the interlocking: the clock, the field, the interlocking itself, the trains, and what they show.
+
+Time is injected: ``step()`` advances the field by one interlocking cycle and then runs the cycle at the new time.
+Nothing here reads the wall clock; pacing to real time belongs to the console.
+
+The world reads the interlocking through its query API (:mod:`.view`, ``World.view``) and drives it through its
+operations. What drives trains on their own (automatic shunting, the ATO's platform doors) sends commands of the
+command language, so it is plugged in from above by the :class:`~simulation.sim.Simulation`: a bare world drives
+only by hand and by signal.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from pathlib import Path
+
+from liansuo.circuits.field import Field
+from liansuo.circuits.railgeometry import Axle
+from liansuo.interlocking.cbi import Interlocking
+from liansuo.interlocking.io import Event, Result
+from liansuo.interlocking.table import InterlockingTable, build_table
+from liansuo.rules import RuleSet, load_rules
+from liansuo.stations.loader import load
+from liansuo.stations.station import Station
+
+from .neighbour import Neighbours
+from .trains.engine import MotionEngine
+from .trains.engines import attach_engine, make_engine
+from .trains.fleet import Fleet, Train
+from .view import AlarmView, InterlockingView, TrainView
+from .wiring import Wiring
+
+
+class World:
+    """One station's world: built from a station (a bundled name, a path or a :class:`Station`), its rules and its
+    table; ``view`` is the interlocking's query API, ``fleet`` the trains, ``field`` the trackside equipment."""
+
+    def __init__(self, station: str | Path | Station, *, cycle_s: float = 0.25, rules: str | RuleSet = "china",
+                 table: InterlockingTable | None = None, engine: str | MotionEngine = "kinematic") -> None:
+        """``engine``: what moves the trains, "kinematic" (built in, the default) or "sumo" (Eclipse SUMO, the
+        ``sumo`` extra; see docs/sumo.md), or a :class:`~simulation.trains.engine.MotionEngine`."""
+        self.rules = load_rules(rules) if isinstance(rules, str) else rules  # one name chooses every part
+        self.station = station if isinstance(station, Station) else load(station, rules=self.rules)
+        self.table = table or build_table(self.station, self.rules)
+        self.cycle_s = cycle_s
+        self.interlocking: Interlocking = Interlocking(self.table, self.rules, cycle_s)
+        self.view = InterlockingView(self.interlocking)
+        self.field: Field = Field(self.station, rules=self.rules)
+        self.wiring = Wiring(self.station, self.rules, self.field)
+        self.neighbours = Neighbours(self.station, self.rules.block_pulse_s)
+        self.t = 0.0
+        self.last_result: Result | None = None  # the answer to the last command (what 'expect refused' checks)
+        self.parked: dict[str, list[Axle]] = {}  # named sets of wheelsets placed by hand (``axles`` command)
+        self.events: deque[Event] = deque(maxlen=20_000)  # the world's own events: trains, faults
+        self.alarms: dict[str, str] = {}  # the world's alarms (derailment, squeeze by a train)
+        motion = make_engine(engine, self.station, cycle_s)
+        self.fleet = Fleet(self.station, self.field, lambda: self.view.outputs.signals, self.log, self.auto_limit,
+                           engine=motion, rules=self.rules)
+        attach_engine(motion, self.fleet)
+        self.wiring.publish(self.view.inputs, everything=True)
+        self.interlocking.cycle(self.t)
+
+    # ---- time -------------------------------------------------------------------------------------------------
+    def step(self) -> None:
+        if self.fleet.trains:
+            self.fleet.step(self.cycle_s)
+            self.after_move()
+            self.update_axles()
+        self.field.step(self.cycle_s, self.wiring.commands_from(self.view.outputs))
+        self.t = round(self.t + self.cycle_s, 9)
+        self.neighbours.step(self.t, self.view.outputs.line_out, self.field.track_up)
+        self.publish()
+        self.interlocking.cycle(self.t)
+
+    def run(self, seconds: float) -> None:
+        for _ in range(max(0, round(seconds / self.cycle_s))):
+            self.step()
+
+    def publish(self) -> None:
+        """Relays follow the field at once; only the interlocking's processing is cyclic."""
+        self.wiring.publish(self.view.inputs)
+        self.neighbours.publish(self.view.inputs)
+
+    def restart_interlocking(self) -> Result:
+        """The interlocking loses power and starts again (全站停电恢复): every route and lock is forgotten, every signal
+        closes, and the station stays locked (上电锁闭) until the operator's power-up release. The field keeps what
+        it had: turnouts lie where they lay, trains stay where they are."""
+        self.interlocking = Interlocking(self.table, self.rules, self.cycle_s, locked_at_start=True)
+        self.interlocking.core.now = self.t
+        self.view = InterlockingView(self.interlocking)
+        self.wiring.relight()
+        self.wiring.publish(self.view.inputs, everything=True)
+        self.neighbours.publish(self.view.inputs)
+        self.interlocking.cycle(self.t)
+        self.log("power", "interlocking restarted: the station is locked until the power-up release (上电解锁)")
+        return Result.accept("interlocking restarted: every section locked and every signal closed until "
+                             "'power-up-release' (上电解锁)")
+
+    def close(self) -> None:
+        """Release what the train engine holds (the SUMO worker process); the kinematic engine holds nothing."""
+        self.fleet.engine.close()
+
+    # ---- wheelsets, doors, the log ------------------------------------------------------------------------------
+    def place_axles(self, name: str, axles: list[Axle]) -> None:
+        """Stand a named set of wheelsets on the track (replacing that name's earlier ones; [] removes them)."""
+        if axles:
+            self.parked[name] = axles
+        else:
+            self.parked.pop(name, None)
+        self.update_axles()
+
+    def update_axles(self) -> None:
+        """Tell the field where every wheelset stands: trains and parked wheelsets."""
+        self.field.set_axles([a for group in self.parked.values() for a in group], self.fleet.shunts())
+
+    def doors(self, platform: str, action: str) -> Result:
+        """Open or close a platform's screen doors through the interlocking (the ``doors`` command, the ATO)."""
+        return self.interlocking.operator.doors(platform, action)
+
+    def log(self, kind: str, text: str) -> None:
+        self.events.append(Event(self.t, kind, text))
+        if kind == "alarm":
+            self.alarms[f"{len(self.alarms)}"] = text
+
+    # ---- what drives trains on their own: nothing in a bare world (the Simulation plugs its automation in) -----
+    def auto_limit(self, train: Train) -> tuple[float, str] | None:
+        """The automatic controller's speed limit for ``train`` this step (m/s) and why; None: the signals rule."""
+        return None
+
+    def attach_auto(self, train: Train, plan: list[str], flags: dict[str, bool] | None = None) -> Result:
+        """Switch ``train`` to automatic shunting with a plan of routes."""
+        return Result.refuse(f"train {train.name}: there is no automatic driving in this world")
+
+    def after_move(self) -> None:
+        """What happens on board after the trains moved (the ATO's platform doors)."""
+
+    # ---- queries ----------------------------------------------------------------------------------------------
+    def aspect(self, signal: str) -> str:
+        return self.view.aspect(signal)
+
+    def route_state(self, route_id: str) -> str:
+        return self.view.route_state(route_id)
+
+    def section_state(self, section: str) -> str:
+        return self.view.section(section).state
+
+    def turnout_state(self, turnout: str) -> tuple[str | None, bool]:
+        """(position indicated or None, locked): locked by a route, an overlap, single lock, guide total lock or the
+        power-up lock, or standing in a locked section."""
+        tv = self.view.turnout(turnout)
+        return tv.position, tv.locked
+
+    def turnout_mark(self, turnout: str) -> str:
+        """What the console marks on a turnout: 'blocked' (单封), 'locked' (单锁), 'guide' (引导总锁闭) or ''."""
+        return self.view.turnout(turnout).mark
+
+    def line_outbound(self, link: str) -> bool:
+        """The direction circuit of an automatic line is set for our departures (改方)."""
+        return self.view.line_outbound(link)
+
+    def train_views(self) -> list[TrainView]:
+        """Every train in the yard."""
+        out = []
+        for tr in self.fleet.trains.values():
+            track, x = self.fleet.front(tr)
+            out.append(TrainView(tr.name, self.fleet.sections_of(tr), round(tr.speed_kmh, 2), tr.direction.value,
+                                 tr.mode, track, round(x, 2)))
+        return out
+
+    def alarm_views(self) -> list[AlarmView]:
+        """Active alarms: the interlocking's, then the world's."""
+        world = [AlarmView(f"world:{k}", "world", "", text, None) for k, text in self.alarms.items()]
+        return [*self.view.alarms(), *world]
+
+    def alarm_texts(self) -> list[str]:
+        return [a.text for a in self.alarm_views()]
+
+    def event_texts(self) -> list[str]:
+        merged = sorted([*self.view.events(), *self.events], key=lambda e: e.t)
+        return [f"{e.t:9.2f} {e.kind:8} {e.text}" for e in merged]
