@@ -2,7 +2,8 @@
 
 A :class:`Language` is built from explicit lists of commands (the Simulation's is the world's commands, the scripts'
 ``expect`` and the trains' commands: :data:`~simulation.sim.LANGUAGE`); nothing is added to it at import or later.
-The console, scripts, scenarios and the API all send their lines through the same one (docs/architecture.md, principle 4).
+The console, scripts, scenarios and the API all send their lines through the same one (docs/architecture.md,
+principle 4).
 
 A language knows nothing of what it drives: it is generic in the thing its handlers are given (``W``). A command
 written for a :class:`~simulation.world.World` serves any world built on it, such as the Simulation.
