@@ -98,12 +98,17 @@ class Core:
     def event(self, kind: str, text: str) -> None:
         self.events.append(Event(self.now, kind, text))
 
-    def alarm(self, key: str, text: str) -> None:
+    def alarm(self, kind: str, element: str, text: str, *, detail: str = "") -> None:
+        """Raise an alarm of ``kind`` (closed, lamp, red, filament, flasher, move, squeeze, spad) on a signal or
+        turnout; ``detail`` tells apart alarms of one kind on one element (the aspect of a lamp alarm, the time of a
+        SPAD). Raised once: an alarm already active stays as it is."""
+        key = Alarm.key_of(kind, element, detail)
         if key not in self.alarms:
-            self.alarms[key] = Alarm(key, self.now, text)
+            self.alarms[key] = Alarm(kind, element, self.now, text, detail)
             self.event("alarm", text)
 
-    def clear_alarm(self, key: str) -> None:
+    def clear_alarm(self, kind: str, element: str) -> None:
+        key = Alarm.key_of(kind, element)
         self.alarms.pop(key, None)
 
     def clear(self, section: str) -> bool:
@@ -138,7 +143,7 @@ class Core:
                 ts.no_indication_since = None
                 if ts.squeeze_alarmed:
                     ts.squeeze_alarmed = False
-                    self.clear_alarm(f"squeeze:{t_id}")
+                    self.clear_alarm("squeeze", t_id)
         for sig in ch.signals:
             self._lamp_alarms(sig)
         self._supervise_turnouts()
@@ -161,25 +166,25 @@ class Core:
         if sig.usu:
             if self.board.flasher_ok(signal):
                 if signal not in self.usu_failed:
-                    self.clear_alarm(f"flasher:{signal}")
+                    self.clear_alarm("flasher", signal)
             else:
                 self.usu_failed.add(signal)
-                self.alarm(f"flasher:{signal}", f"signal {signal}: USU flasher failed (SNJ/SNJJ down); USU "
+                self.alarm("flasher", signal, f"signal {signal}: USU flasher failed (SNJ/SNJJ down); USU "
                            "degrades to UU")
         if self.board.filament_alarm.get(signal, False):
-            self.alarm(f"filament:{signal}", f"signal {signal}: main filament broken (主丝断丝), lamp on its backup "
+            self.alarm("filament", signal, f"signal {signal}: main filament broken (主丝断丝), lamp on its backup "
                        "filament or dark")
         else:
-            self.clear_alarm(f"filament:{signal}")
+            self.clear_alarm("filament", signal)
         stop = stop_aspect(self.station, signal)  # the red (or blue) lamp is named as the stop aspect it shows
         if stop in [lamp.value for lamp in sig.lamps]:
             dark = not self.board.lamp_ok(signal, stop)
             if dark != self.signals[signal].red_dark:
                 self.signals[signal].red_dark = dark
                 if dark:
-                    self.alarm(f"red:{signal}", f"signal {signal}: {stop} lamp dark (both filaments)")
+                    self.alarm("red", signal, f"signal {signal}: {stop} lamp dark (both filaments)")
                 else:
-                    self.clear_alarm(f"red:{signal}")
+                    self.clear_alarm("red", signal)
 
     # ---- turnouts -------------------------------------------------------------------------------------------
     def _supervise_turnouts(self) -> None:
@@ -190,7 +195,7 @@ class Core:
                 # never started again under the movement (the turnout stays without indication: fail-safe)
                 self.moving.discard(t_id)
                 self.out.drive(t_id, None)
-                self.alarm(f"move:{t_id}", f"turnout {t_id}: drive to {ts.target} stopped, section {ts.section} "
+                self.alarm("move", t_id, f"turnout {t_id}: drive to {ts.target} stopped, section {ts.section} "
                            "became occupied during the move")
                 ts.target = None
                 ts.move_started = None
@@ -201,11 +206,11 @@ class Core:
                 self.event("turnout", f"turnout {t_id} in {ts.target}")
                 ts.target = None
                 ts.move_started = None
-                self.clear_alarm(f"move:{t_id}")
+                self.clear_alarm("move", t_id)
             elif ts.move_started is not None and self.now - ts.move_started > self.rules.turnout_timeout_s:
                 self.moving.discard(t_id)
                 self.out.drive(t_id, None)
-                self.alarm(f"move:{t_id}", f"turnout {t_id} did not reach {ts.target} within "
+                self.alarm("move", t_id, f"turnout {t_id} did not reach {ts.target} within "
                            f"{self.rules.turnout_timeout_s:g} s (no indication)")
                 ts.target = None
                 ts.move_started = None
@@ -233,7 +238,7 @@ class Core:
             since = ts.no_indication_since if ts.no_indication_since is not None else 0.0
             if self.now - since >= self.rules.squeeze_alarm_s:
                 ts.squeeze_alarmed = True
-                self.alarm(f"squeeze:{t_id}", f"turnout {t_id} squeezed (挤岔): no indication for "
+                self.alarm("squeeze", t_id, f"turnout {t_id} squeezed (挤岔): no indication for "
                            f"{self.rules.squeeze_alarm_s:g} s")
 
     def request_move(self, turnout: str, position: str) -> None:
@@ -411,8 +416,8 @@ class Core:
         if not dark:
             return aspect
         shown = downgrade(aspect, dark, self.rules)
-        self.alarm(f"lamp:{signal}:{aspect}", f"signal {signal}: lamp(s) {', '.join(sorted(dark))} dark for "
-                   f"{aspect}; showing {shown}")
+        self.alarm("lamp", signal, f"signal {signal}: lamp(s) {', '.join(sorted(dark))} dark for {aspect}; showing "
+                   f"{shown}", detail=aspect)
         return shown
 
     def send(self, link: str, pulse: str) -> None:

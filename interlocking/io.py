@@ -150,9 +150,22 @@ class Event:
     text: str
 
 
-@dataclass
+@dataclass(frozen=True)
 class Alarm:
-    key: str
+    """An active alarm: its kind (closed, lamp, red, filament, flasher, move, squeeze, spad), the signal or turnout
+    it concerns, when it was raised and what it says; ``detail`` tells apart alarms of one kind on one element."""
+
+    kind: str
+    element: str
     t: float
     text: str
-    acknowledged: bool = False
+    detail: str = ""
+
+    @staticmethod
+    def key_of(kind: str, element: str, detail: str = "") -> str:
+        return f"{kind}:{element}" + (f":{detail}" if detail else "")
+
+    @property
+    def key(self) -> str:
+        """What names it (and what the console acknowledges it by)."""
+        return self.key_of(self.kind, self.element, self.detail)

@@ -248,7 +248,7 @@ class RouteLifecycle:
 
     def reopen(self, rs: RouteState) -> None:
         """closed -> open (重复开放), the operator having seen the conditions are back."""
-        self.il.clear_alarm(f"closed:{rs.route.signal}")
+        self.il.clear_alarm("closed", rs.route.signal)
         self.open(rs)
 
     def open_guide(self, rs: RouteState) -> None:
@@ -258,7 +258,7 @@ class RouteLifecycle:
         rs.guide_first_clear = il.clear(rs.route.sections[0])
         rs.guide_approach_seen = False
         rs.since = il.now
-        il.clear_alarm(f"closed:{signal}")
+        il.clear_alarm("closed", signal)
         il.signals[signal].route = rs.id
         guide = il.rules.aspects.guide
         il.out.set_aspect(signal, guide)
@@ -273,7 +273,7 @@ class RouteLifecycle:
         il.codes_dirty = True
         if abnormal:
             rs.stage = RouteStage.closed
-            il.alarm(f"closed:{r.signal}", f"signal {r.signal} closed: {reason}")
+            il.alarm("closed", r.signal, f"signal {r.signal} closed: {reason}")
         else:
             il.event("signal", f"signal {r.signal} closed: {reason}")
 
@@ -322,7 +322,7 @@ class RouteLifecycle:
         il.routes.pop(rs.id, None)
         if il.by_signal.get(r.signal) == rs.id:
             del il.by_signal[r.signal]
-        il.clear_alarm(f"closed:{r.signal}")
+        il.clear_alarm("closed", r.signal)
         il.codes_dirty = True
         il.event("route", f"route {r.id} released")
 
@@ -349,7 +349,7 @@ class RouteLifecycle:
         del il.guide_only[signal]
         il.out.set_aspect(signal, stop_aspect(il.station, signal))
         if alarm:
-            il.alarm(f"closed:{signal}", f"signal {signal} closed: {alarm}")
+            il.alarm("closed", signal, f"signal {signal} closed: {alarm}")
 
     def _guide_only(self) -> None:
         il = self.il
@@ -386,8 +386,8 @@ class RouteLifecycle:
                 rear = st.signal_rear_track(sig)
                 if rear is None or il.clear(st.tracks[rear].section):
                     continue
-                il.alarm(f"spad:{sig}:{il.now:.2f}", f"signal {sig} passed at danger (冒进信号): {sec} occupied "
-                         "with the signal closed")
+                il.alarm("spad", sig, f"signal {sig} passed at danger (冒进信号): {sec} occupied with the signal "
+                         "closed", detail=f"{il.now:.2f}")
                 if own is not None:
                     self.enter_at_danger(il.routes[own])
 

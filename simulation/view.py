@@ -1,6 +1,6 @@
 """The query API: what the trains, the console and every other front end read of the interlocking, as typed records.
 
-The interlocking's inner state (route states, the lock ledger, turnout supervision, alarm keys) is read here and
+The interlocking's inner state (route states, the lock ledger, turnout supervision, alarms) is read here and
 nowhere else in the world or above it, so a change inside the interlocking is adapted in this one module. Its relay
 interface (:class:`~interlocking.io.RelayBoard` in, :class:`~interlocking.io.Outputs` out) is the contract with the
 field and is handed on as it is.
@@ -206,11 +206,7 @@ class InterlockingView:
     # ---- alarms and events --------------------------------------------------------------------------------------
     def alarms(self) -> tuple[AlarmView, ...]:
         """The interlocking's active alarms, oldest first."""
-        out = []
-        for a in self._il.alarms.values():
-            kind, _, rest = a.key.partition(":")  # the interlocking's keys: KIND:ELEMENT[:DETAIL]
-            out.append(AlarmView(a.key, kind, rest.partition(":")[0], a.text, a.t))
-        return tuple(out)
+        return tuple(AlarmView(a.key, a.kind, a.element, a.text, a.t) for a in self._il.alarms.values())
 
     def events(self) -> Sequence[Event]:
         """The interlocking's event log (a live sequence, newest last)."""
