@@ -15,6 +15,7 @@ import time
 from collections.abc import Callable, Iterable, Sequence
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
+from importlib.resources import files
 from pathlib import Path
 
 from liansuo.stations.hubgen import generate_hub
@@ -49,11 +50,11 @@ HUB = "hub:10:4"  # a small generated hub: lines with no block described, double
 
 
 def default_stations() -> list[str]:
-    """The bundled stations, the example stations when run from a checkout, and a small generated hub; the quickest
-    to verify first."""
+    """The bundled stations, the example stations (installed with the package, ``liansuo/examples``) and a small
+    generated hub; the quickest to verify first."""
     out = sorted(bundled(), key=lambda name: (name != "jiaopei", name))
-    examples = Path(__file__).resolve().parents[1] / "examples" / "stations"  # in a checkout
-    if examples.is_dir():
+    examples = Path(str(files("liansuo"))) / "examples" / "stations"  # installed with the package
+    if examples.is_dir():  # always, unless the package was installed without its data
         out[1:1] = [str(p) for p in sorted(examples.glob("*.yaml")) if p.stem != "minimal"]
     return [*out, HUB]
 

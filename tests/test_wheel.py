@@ -33,7 +33,7 @@ ROOT = Path(__file__).resolve().parents[1]
 BIN = "Scripts" if os.name == "nt" else "bin"
 # folders of the checkout the build does not read (the wheel is built from a copy, never from the checkout itself,
 # so no build/ folder is left behind and no stale build/lib can hide a file the package data misses)
-NOT_COPIED_AT_TOP = {".venv", ".git", "build", "dist", "tests", "docs", "examples"}
+NOT_COPIED_AT_TOP = {".venv", ".git", "build", "dist", "tests", "docs"}
 NOT_COPIED = {"__pycache__", ".pytest_cache", ".mypy_cache", ".ruff_cache", ".hypothesis"}
 # environment variables that would let the installed package see the checkout or another environment
 DROPPED_ENV = {"PYTHONPATH", "PYTHONHOME", "PYTHONSTARTUP", "VIRTUAL_ENV", "PYTHONUSERBASE"}
@@ -67,6 +67,9 @@ sim.run(2)
 print("route X-XI", sim.route_state("X-XI"), "signal X", sim.aspect("X"))
 table = liansuo.build_table(liansuo.load_station("jiaopei"))
 print("table", len(table.routes), "routes, X-XI conflicts with", ", ".join(sorted(table.routes["X-XI"].conflicts)[:3]))
+from liansuo.proving.mutation import default_stations  # the example stations install too: mutate runs on them
+
+print("mutate stations", " ".join(s.rsplit("/", 1)[-1] for s in default_stations()))
 """
 
 EXERCISE_CHECK = """\
@@ -301,6 +304,7 @@ def test_the_public_api_runs_from_the_installed_package(installed: Installed) ->
     assert package.is_relative_to(installed.venv.resolve()), f"liansuo was imported from {package}, not the venv"
     assert "route X-XI open signal X U" in out, f"the public API:\n{out}"
     assert "table 25 routes" in out, f"the public API:\n{out}"
+    assert "danxian.yaml" in out and "shuangxian.yaml" in out, f"the example stations are not installed:\n{out}"
 
 
 def test_a_bundled_exercise_loads_by_name_and_its_goal_is_reached(installed: Installed) -> None:
