@@ -61,7 +61,7 @@ class Core:
         self.locks = LockLedger(st.turnout_section, st.pairs)
         self.overlap_pending: dict[str, float | None] = {}  # route -> when its overlap releases (after the route)
         self.turnouts = {t: TurnoutState(t, st.turnout_section[t], st.turnouts[t].trailable) for t in st.turnouts}
-        self.signals = {s.id: SignalState(s.id, stop_aspect(st, s.id)) for s in st.model.signals}
+        self.signals = {s.id: SignalState(s.id) for s in st.model.signals}
         for sig in st.model.signals:
             self.out.set_aspect(sig.id, stop_aspect(st, sig.id))
         self.links = {lk.id: BlockLink(lk.id, lk.sections[0] if lk.sections else "")

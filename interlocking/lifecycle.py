@@ -240,7 +240,6 @@ class RouteLifecycle:
         il, r = self.il, rs.route
         rs.stage = RouteStage.open
         rs.since = il.now
-        il.signals[r.signal].route = r.id
         aspect = il.proven(r.signal, il.wanted_aspect(rs))
         il.out.set_aspect(r.signal, aspect)
         il.codes_dirty = True
@@ -259,7 +258,6 @@ class RouteLifecycle:
         rs.guide_approach_seen = False
         rs.since = il.now
         il.clear_alarm("closed", signal)
-        il.signals[signal].route = rs.id
         guide = il.rules.aspects.guide
         il.out.set_aspect(signal, guide)
         il.codes_dirty = True
@@ -317,7 +315,6 @@ class RouteLifecycle:
                 self.release_overlap(rs.id)
         if il.out.signals.get(r.signal) != stop_aspect(il.station, r.signal):
             il.out.set_aspect(r.signal, stop_aspect(il.station, r.signal))
-        il.signals[r.signal].route = None
         il.usu_failed.discard(r.signal)
         il.routes.pop(rs.id, None)
         if il.by_signal.get(r.signal) == rs.id:

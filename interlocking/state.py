@@ -88,7 +88,7 @@ class TurnoutState:
 
 @dataclass
 class SignalState:
+    """What the interlocking remembers of one signal (its aspect is in the outputs, its route in ``by_signal``)."""
+
     id: str
-    aspect: str
-    route: str | None = None  # route whose signal this is, while set
-    red_dark: bool = False
+    red_dark: bool = False  # the stop lamp is dark (both filaments): red lamp transfer to the signal in rear
