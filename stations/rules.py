@@ -101,16 +101,36 @@ class _Warner:
                           f"{self.r.dead_zone_short_m:g} m)",
                           "a short vehicle could stand in both dead zones at once and vanish from the interlocking")
 
+    def _tracks_near(self, joint: str, reach: float) -> set[str]:
+        """The tracks a movement can reach from ``joint`` within ``reach`` metres either way, through any turnout: a
+        fouling point elsewhere (a parallel track at the same kilometre) is no concern of the signal there."""
+        st, at = self.st, self.st.joints[joint].at
+        seen: set[str] = set()
+        todo = [t for _, t in st.node_tracks[joint]]
+        while todo:
+            track = todo.pop()
+            if track in seen:
+                continue
+            seen.add(track)
+            for port in st.track_ports[track]:
+                if port.node != joint and abs(st.node_at(port.node) - at) < reach:
+                    todo += [t for _, t in st.node_tracks[port.node] if t not in seen]
+        return seen
+
     def fouling(self) -> None:
         clearance = self.r.fouling_clearance_emu_m if self.st.model.emu else self.r.fouling_clearance_m
+        reach = 50.0  # how far either way a fouling point is looked for
         for sig in self.st.model.signals:
             if sig.kind is not SignalKind.starting or sig.at not in self.st.joints:
                 continue
             j = self.st.joints[sig.at]
             ahead = 1.0 if sig.direction is Direction.down else -1.0
+            near = self._tracks_near(j.id, reach)
             for fp in self.st.model.fouling_points:
+                if fp.track not in near:
+                    continue
                 d = (fp.at - j.at) * ahead
-                if -50.0 < d < clearance and abs(d) < 50.0:
+                if -reach < d < clearance:
                     self.warn(self.loc("fouling_points", fp.id, "at"),
                               f"fouling point {fp.id} is {d:.1f} m ahead of the joint of starting signal {sig.id} "
                               f"(need >= {clearance:g} m)"

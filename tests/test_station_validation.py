@@ -418,9 +418,16 @@ def test_no_warning_within_the_limits() -> None:
         edit(BASE, ("{id: IAG, type: 25hz, role: approach}",
                     "{id: IAG, type: zpw2000a, carrier: 2300-1, role: approach}"),
              ("{id: 1DG, type: 25hz}", "{id: 1DG, type: zpw2000a, carrier: 1700-2}")),
+        # a fouling point on another track at the kilometre of the starting signal's joint: the siding 3G runs on
+        # beside IG past XI, but no movement from XI reaches it (once a false positive, compared by kilometre only)
+        edit(BASE, ("{id: B-3, kind: buffer, at: 600}", "{id: B-3, kind: buffer, at: 1000}"),
+             ("track: t-1b, at: 290}", "track: t-3G, at: 902}")),
+        # a ZPW-2000A turnout section whose legs add up to 330 m but whose main run is 280 m: no capacitors needed
+        edit(BASE, ("{id: J-13, at: 310}", "{id: J-13, at: 480}"),
+             ("{id: 1DG, type: 25hz}", "{id: 1DG, type: zpw2000a, carrier: 1700-2}")),
     ]
     for text in ok:
-        assert warnings_of(text) == []
+        assert warnings_of(text) == [], "\n".join(str(w) for w in warnings_of(text))
 
 
 # ---- random damage never escapes as anything but StationError ---------------------------------------------------
