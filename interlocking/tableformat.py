@@ -1,4 +1,8 @@
-"""The interlocking table as text (like the signed table), CSV and JSON."""
+"""The interlocking table as text (the signed layout, at most 120 columns), CSV and JSON.
+
+Text and CSV print the cells of :mod:`.signedtable`, so they agree with each other and with the xlsx export
+(:mod:`.tablexlsx`); JSON is the table's data (``InterlockingTable.as_dict``) with the signed groups added.
+"""
 
 from __future__ import annotations
 
@@ -6,59 +10,84 @@ import csv
 import io
 import json
 
-from .table import InterlockingTable, Route
+from .signedtable import COLUMNS, SignedTable, cell_width, signed_table
+from .table import InterlockingTable
+
+WIDTH = 120
+LEGEND = ("道岔 1 定位, (1) 反位, [1] 防护, {1} 带动, (1/3) 双动; 轨道区段 <5DG> 侵限; "
+          "敌对信号 <1>D1 / <(1)>D1: 1 定位 / 反位时敌对; 按钮 XLA 列车, XDA 调车")
 
 
-def _turnouts(r: Route) -> str:
-    parts = []
-    for t in r.turnouts:
-        pos = t.id if t.position.value == "normal" else f"({t.id})"  # reverse is written in brackets
-        if t.role == "protection":
-            pos = f"[{pos}]"
-        elif t.role == "driven":
-            pos = f"{{{pos}}}"
-        parts.append(pos)
-    return " ".join(parts)
+def wrap(text: str, width: int) -> list[str]:
+    """``text`` in lines of at most ``width`` display columns, broken at spaces (a longer word is cut)."""
+    lines: list[str] = []
+    line = ""
+    for word in text.split(" "):
+        while cell_width(word) > width:  # cut a word that fits no line
+            if line:
+                lines.append(line)
+                line = ""
+            cut = 0
+            while cell_width(word[:cut + 1]) <= width:
+                cut += 1
+            lines.append(word[:cut])
+            word = word[cut:]
+        candidate = f"{line} {word}" if line else word
+        if cell_width(candidate) <= width:
+            line = candidate
+        else:
+            lines.append(line)
+            line = word
+    if line or not lines:
+        lines.append(line)
+    return lines
+
+
+def _pad(text: str, width: int) -> str:
+    return text + " " * (width - cell_width(text))
+
+
+def _line(cells: list[str]) -> str:
+    return " ".join(_pad(c, col.width) for c, col in zip(cells, COLUMNS, strict=True)).rstrip()
+
+
+def render_text(signed: SignedTable, table: InterlockingTable) -> str:
+    lines = [f"联锁表 {signed.title}", f"station file {signed.file} sha256 {signed.sha256[:16]}",
+             *wrap(LEGEND, WIDTH)]
+    header = _line([c.heading for c in COLUMNS])
+    for g in signed.groups:
+        lines += ["", f"== {g.name} ==", header, "-" * WIDTH]
+        for row in g.rows:
+            wrapped = [wrap(row.cells[c.key], c.width) for c in COLUMNS]
+            for i in range(max(len(w) for w in wrapped)):
+                lines.append(_line([w[i] if i < len(w) else "" for w in wrapped]))
+    lines.append("")
+    throats = "; ".join(f"{k}: {' '.join(v)}" for k, v in table.throats.items())
+    if throats:
+        lines += wrap(f"咽喉 (引导总锁闭) {throats}", WIDTH)
+    if table.unselectable:
+        lines += wrap("无变通按钮, 不能排列的径路: " + "; ".join(table.unselectable), WIDTH)
+    lines.append(f"{len(table.routes)} 条进路 routes")
+    return "\n".join(lines)
 
 
 def as_text(table: InterlockingTable) -> str:
-    st = table.station
-    lines = [f"联锁表 Interlocking table: {st.model.name.zh} ({st.model.name.en}), station id {st.id}",
-             "turnouts: 1 = normal, (1) = reverse, [1] = flank protection (防护), {1} = driven (带动)", ""]
-    header = f"{'No.':>3}  {'route':<14} {'kind':<9} {'buttons':<14} {'signal':<7} {'aspects':<10} " \
-             f"{'turnouts':<26} {'sections':<34} {'approach':<8} conflicting routes"
-    lines.append(header)
-    lines.append("-" * len(header))
-    for n, r in enumerate(table.routes.values(), 1):
-        buttons = " ".join([r.start, *r.via, r.end])
-        sections = " ".join(r.sections) + ("".join(f" <{f.section}>" for f in r.fouling))
-        if r.overlap_sections:
-            sections += " +overlap " + " ".join(r.overlap_sections)
-        conflicts = ", ".join(sorted(r.conflicts))
-        lines.append(f"{n:>3}  {r.id:<14} {r.category:<9} {buttons:<14} {r.signal:<7} {'/'.join(r.aspects):<10} "
-                     f"{_turnouts(r):<26} {sections:<34} {' '.join(r.approach):<8} {conflicts}")
-        if r.opposing:
-            lines.append(f"{'':>3}  {'':<14} opposing: {', '.join(r.opposing)}")
-    lines.append("")
-    lines.append("throats (guide total lock): " + "; ".join(f"{k}: {' '.join(v)}" for k, v in table.throats.items()))
-    if table.unselectable:
-        lines.append("paths without a distinguishing variant button (not selectable): " + "; ".join(table.unselectable))
-    lines.append(f"{len(table.routes)} routes")
-    return "\n".join(lines)
+    return render_text(signed_table(table), table)
 
 
 def as_csv(table: InterlockingTable) -> str:
     buf = io.StringIO()
     w = csv.writer(buf)
-    w.writerow(["id", "kind", "category", "start", "via", "end", "signal", "aspects", "turnouts", "sections",
-                "fouling_sections", "approach", "overlap", "conflicts", "opposing"])
-    for r in table.routes.values():
-        w.writerow([r.id, r.kind, r.category, r.start, " ".join(r.via), r.end, r.signal, "/".join(r.aspects),
-                    " ".join(f"{t.id}:{t.position.value}:{t.role}" for t in r.turnouts), " ".join(r.sections),
-                    " ".join(f.section for f in r.fouling), " ".join(r.approach), " ".join(r.overlap_sections),
-                    " ".join(sorted(r.conflicts)), " ".join(r.opposing)])
+    w.writerow(["id", "group", *(c.key for c in COLUMNS)])
+    for g in signed_table(table).groups:
+        for row in g.rows:
+            w.writerow([row.route, g.name, *(row.cells[c.key] for c in COLUMNS)])
     return buf.getvalue()
 
 
 def as_json(table: InterlockingTable) -> str:
-    return json.dumps(table.as_dict(), ensure_ascii=False, indent=2)
+    data = table.as_dict()
+    signed = signed_table(table)
+    data["station_file"] = {"name": signed.file, "sha256": signed.sha256}
+    data["groups"] = signed.as_dict()
+    return json.dumps(data, ensure_ascii=False, indent=2)
