@@ -1,9 +1,13 @@
-"""``liansuo table STATION [--format text|csv|json]``: the interlocking table (联锁表) derived from the topology."""
+"""``liansuo table STATION [--format text|csv|json|xlsx] [-o FILE] [--schema]``: the interlocking table (联锁表)
+derived from the topology, in the signed layout (docs/interlocking-table.md)."""
 
 from __future__ import annotations
 
 import argparse
+import json
+import sys
 from collections.abc import Callable
+from pathlib import Path
 
 from liansuo.stations.cli import print_errors
 from liansuo.stations.loader import load
@@ -13,19 +17,44 @@ Add = Callable[..., argparse.ArgumentParser]
 
 
 def cmd_table(args: argparse.Namespace) -> int:
-    from .table import build_table  # the derivation (networkx) loads only when a table is asked for
+    # the derivation (networkx) and the xlsx writer (openpyxl) load only when a table is asked for
+    from .signedtable import signed_table
+    from .table import build_table
     from .tableformat import as_csv, as_json, as_text
+    from .tableschema import TABLE_SCHEMA
 
+    if args.schema:
+        print(json.dumps(TABLE_SCHEMA, ensure_ascii=False, indent=2))
+        return 0
+    if args.station is None:
+        print("liansuo table: a STATION is needed (or --schema)", file=sys.stderr)
+        return 2
+    if args.format == "xlsx" and args.output is None:
+        print("liansuo table: --format xlsx needs -o FILE", file=sys.stderr)
+        return 2
     try:
         table = build_table(load(args.station))
     except StationError as exc:
         return print_errors(exc)
-    print({"text": as_text, "csv": as_csv, "json": as_json}[args.format](table), end="" if args.format == "csv"
-          else "\n")
+    if args.format == "xlsx":
+        from .tablexlsx import write_xlsx
+
+        write_xlsx(signed_table(table), Path(args.output))
+        print(f"wrote {args.output}")
+        return 0
+    text = {"text": as_text, "csv": as_csv, "json": as_json}[args.format](table)
+    if args.format != "csv":
+        text += "\n"
+    if args.output is None:
+        print(text, end="")
+    else:
+        Path(args.output).write_text(text, encoding="utf-8")
     return 0
 
 
 def register(add: Add) -> None:
     sp = add("table", cmd_table, "print the interlocking table (联锁表) derived from the topology")
-    sp.add_argument("station", help="bundled station name or path")
-    sp.add_argument("--format", choices=("text", "csv", "json"), default="text")
+    sp.add_argument("station", nargs="?", help="bundled station name or path")
+    sp.add_argument("--format", choices=("text", "csv", "json", "xlsx"), default="text")
+    sp.add_argument("-o", "--output", help="write to FILE (needed for xlsx)")
+    sp.add_argument("--schema", action="store_true", help="print the JSON Schema of --format json and exit")
