@@ -129,10 +129,11 @@ def test_table_command_formats(fmt: str, capsys: pytest.CaptureFixture[str]) -> 
         d2xi = next(r for r in data["routes"] if r["id"] == "D2-XI")
         assert d2xi["leads_into"] == "IG" and "X-XI" in d2xi["conflicts"]
     elif fmt == "csv":
-        assert out.splitlines()[0].startswith("id,kind,category")
-        assert any(line.startswith("X-XI,train,receiving") for line in out.splitlines())
+        # the signed layout's cells, keyed by route id (tests/test_signed_table.py checks them)
+        assert out.splitlines()[0].startswith("id,group,no,route,mode,buttons")
+        assert any(line.startswith("X-XI,下行接车 X咽喉,") for line in out.splitlines())
     else:
-        assert "联锁表" in out and "X-XI" in out and "{3}" in out
+        assert "联锁表" in out and "至 IG" in out and "1/3" in out
 
 
 def test_variant_route_by_via_button_takes_the_detour(capsys: pytest.CaptureFixture[str]) -> None:

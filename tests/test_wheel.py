@@ -293,7 +293,11 @@ def test_the_command_line_lists_stations_and_prints_the_table(installed: Install
     out = must("liansuo stations", [installed.liansuo, "stations"], installed.work, installed.env)
     assert all(name in out for name in ("jiaopei", "gaotie", "depot")), f"liansuo stations:\n{out}"
     out = must("liansuo table jiaopei", [installed.liansuo, "table", "jiaopei"], installed.work, installed.env)
-    assert "联锁表" in out and "X-XI" in out and "receiving" in out, f"liansuo table jiaopei:\n{out}"
+    assert "联锁表" in out and "下行接车" in out and "至 IG" in out, f"liansuo table jiaopei:\n{out}"
+    xlsx = installed.work / "jiaopei.xlsx"  # openpyxl, a dependency, installed from the registry
+    must("liansuo table jiaopei --format xlsx", [installed.liansuo, "table", "jiaopei", "--format", "xlsx", "-o", xlsx],
+         installed.work, installed.env)
+    assert xlsx.stat().st_size > 0
     out = must("liansuo tui --help", [installed.liansuo, "tui", "--help"], installed.work, installed.env)
     assert "--exercise" in out, f"liansuo tui --help:\n{out}"
 
