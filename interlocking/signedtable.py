@@ -227,7 +227,7 @@ class _Builder:
         ts = [t.id for t in r.turnouts if t.role == "route"]
         sig = self.st.signals.get(r.signal)
         at = (sum(self.st.node_at(t) for t in ts) / len(ts) if ts
-              else self.st.node_at(sig.at) if sig and sig.at in self.st.joints else 0.0)
+              else self.st.node_at(sig.at) if sig and (sig.at in self.st.joints or sig.at in self.st.ends) else 0.0)
         return min(self.centres, key=lambda name: abs(self.centres[name] - at))
 
     def groups(self) -> tuple[Group, ...]:
