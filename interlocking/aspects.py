@@ -15,7 +15,7 @@ from liansuo.stations.schema import SignalKind, TurnoutPosition
 from liansuo.stations.station import Station
 
 if TYPE_CHECKING:
-    from collections.abc import Iterable
+    from collections.abc import Callable, Iterable
 
     from .route import Route, RouteTurnout
 
@@ -57,10 +57,23 @@ def onward_allows_usu(station: Station, turnouts: Iterable[RouteTurnout], rules:
                if t.role == "route" and t.position is TurnoutPosition.reverse)
 
 
+def follow(next_aspect: str) -> str:
+    """The aspect of a signal whose route runs straight, by the aspect of the next signal ('' when there is none)."""
+    if next_aspect == "UU":
+        return "U"
+    if next_aspect in ("L", "LL", "LU", "USU"):
+        return "L"
+    if next_aspect == "U":
+        return "LU"
+    return "U"
+
+
 def possible_aspects(station: Station, route: Route, rules: RuleSet | None = None,
-                     onward: Iterable[Route] = ()) -> tuple[str, ...]:
+                     onward: Iterable[Route] = (), onward_aspects: Callable[[Route], tuple[str, ...]] | None = None
+                     ) -> tuple[str, ...]:
     """What the table lists: every proceed aspect the route's signal can show for it (``onward``: the train routes
-    from its end signal)."""
+    from its end signal; ``onward_aspects``: what the table lists for one of them). A straight route follows the next
+    signal, so it lists only what follows from an aspect that signal can show, or from its stop."""
     rules = rules or load_rules()
     if route.kind == "shunt":
         return ("B",)
@@ -76,7 +89,11 @@ def possible_aspects(station: Station, route: Route, rules: RuleSet | None = Non
         usu = usu_allowed(station, route, rules) and any(onward_allows_usu(station, o.turnouts, rules)
                                                          for o in onward)
         return ("UU", "USU") if usu else ("UU",)
-    return ("L", "LU", "U")
+    if onward_aspects is None or route.end_signal is None:
+        return ("L", "LU", "U")
+    nexts = {TRAIN_STOP, *(a for o in onward for a in onward_aspects(o))}
+    shown = {follow(a) for a in nexts}
+    return tuple(a for a in ("L", "LU", "U") if a in shown)
 
 
 def select_aspect(station: Station, route: Route, next_aspect: str, clear_blocks: int | None,
@@ -105,14 +122,7 @@ def select_aspect(station: Station, route: Route, next_aspect: str, clear_blocks
         if usu_allowed(station, route, rules) and usu_ready and next_aspect in ("L", "LU", "LL", "USU"):
             return "USU"
         return "UU"
-    # straight over the main line: follow the next signal
-    if next_aspect == "UU":
-        return "U"
-    if next_aspect in ("L", "LL", "LU", "USU"):
-        return "L"
-    if next_aspect == "U":
-        return "LU"
-    return "U"
+    return follow(next_aspect)  # straight over the main line: follow the next signal
 
 
 def downgrade(aspect: str, dark: set[str], rules: RuleSet | None = None) -> str:

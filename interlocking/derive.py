@@ -416,8 +416,18 @@ class _Builder:
         for r in routes.values():
             if r.kind == "train":
                 onward[r.signal].append(r)
+        listed: dict[str, tuple[str, ...]] = {}
+
+        def aspects_of(r: Route, through: frozenset[str] = frozenset()) -> tuple[str, ...]:
+            if r.id not in listed:
+                if r.id in through:  # a ring of train routes (none in one direction, but never loop)
+                    return ("L", "LU", "U")
+                listed[r.id] = possible_aspects(self.st, r, self.rules, onward.get(r.end_signal or "", ()),
+                                                lambda o: aspects_of(o, through | {r.id}))
+            return listed[r.id]
+
         for r in routes.values():
-            r.aspects = possible_aspects(self.st, r, self.rules, onward.get(r.end_signal or "", ()))
+            r.aspects = aspects_of(r)
         return InterlockingTable(self.st, routes, self._throats(), unselectable)
 
     def _via(self, path: Path, basic: Path) -> str | None:

@@ -83,7 +83,8 @@ def test_jiaopei_table_rows_a_signal_engineer_expects() -> None:
     assert r.category == "receiving" and r.sections == ("7DG", "1DG", "IG") and r.approach == ("IAG",)
     assert {(t.id, t.position.value, t.role) for t in r.turnouts} == {
         ("7", "normal", "route"), ("1", "normal", "route"), ("3", "normal", "driven")}  # 3 moves with 1 (1/3)
-    assert r.aspects == ("L", "LU", "U")
+    # straight to XI, which departs onto a 64D line and so shows only L: X shows L, or U with XI at stop, never LU
+    assert r.aspects == ("L", "U") and table.routes["XI-S"].aspects == ("L",)
     assert table.routes["X-X3"].aspects == ("UU",)  # No. 12 turnouts: no USU
     assert table.routes["XI-S"].category == "departure" and table.routes["XI-S"].exit_link == "SL"
     assert "S-SI" in r.opposing and "X-X3" not in r.opposing
@@ -95,6 +96,7 @@ def test_gaotie_home_signal_may_show_usu_over_no18() -> None:
     table = build_table(load("gaotie"))
     assert "USU" in table.routes["X-X3"].aspects
     assert table.routes["XI-XFCK"].aspects == ("L", "LU", "U")
+    assert table.routes["X-XI"].aspects == ("L", "LU", "U")  # XI shows U with one clear block section: X shows LU
 
 
 def test_override_forbid_removes_a_route_and_unknown_route_is_an_error_with_line() -> None:

@@ -51,7 +51,7 @@ def test_jiaopei_rows_read_as_an_engineer_writes_them() -> None:
     group, x_xi = t["X-XI"]
     assert group == "下行接车 X咽喉"
     assert x_xi.cells["route"] == "至 IG" and x_xi.cells["mode"] == "基本"
-    assert x_xi.cells["buttons"] == "XLA XILA" and x_xi.cells["aspects"] == "L/LU/U"
+    assert x_xi.cells["buttons"] == "XLA XILA" and x_xi.cells["aspects"] == "L/U"
     # the crossover pair once, with no separate driven or protection turnout for its partner
     assert x_xi.cells["turnouts"] == "7 1/3"
     assert t["X-X3"][1].cells["turnouts"] == "7 (1/3) 5"
