@@ -103,6 +103,9 @@ class Oracle:
         self.approached: set[str] = set()  # open signals whose section in rear was occupied at the last check
         self.operated: set[str] = set()  # open guide aspects the operator answers for
         self.guide_locked: set[str] = set()  # throats (named by their home signal) under guide total lock
+        # sections the operator released by section fault release (区故解) while a movement's authority still reached
+        # over them: the interlocking grants it on the operator's word, so what follows there is a hazard
+        self.fault_released: set[str] = set()
         self.turnout_sections_clear: dict[str, bool] = {}  # turnout sections as they were at the last check
         self.now = 0.0
 
@@ -122,8 +125,11 @@ class Oracle:
             self.guide_locked.add(words[1])
         elif accepted and len(words) >= 2 and words[0] == "guide-unlock":
             self.guide_locked.discard(words[1])
+        elif accepted and len(words) >= 2 and words[0] == "fault-release":
+            self.fault_released.add(words[1])
         elif accepted and words[:1] == ["restart"]:
             self.guide_locked.clear()
+            self.fault_released.clear()
 
     # ---- one check ---------------------------------------------------------------------------------------------------
     def check(self, view: FieldView, now: float, showing: Iterable[str]) -> list[Finding]:
@@ -137,6 +143,7 @@ class Oracle:
             a = self.open[sig]
             held.append(self._judge_open(sig, aspect, a, view, shown, found))
         held += self._in_use(view)
+        self.fault_released &= {s for u in self.in_use for s in u.sections}  # the movement's authority is gone
         self._across(held, found)
         self._moving(view, held, found)
         return self._report(found)
@@ -433,6 +440,8 @@ class Oracle:
             if a.auth is b.auth:
                 continue
             hazard, delayed = a.operator or b.operator, a.unsettled or b.unsettled
+            # where the operator released a section of one of them by hand, what follows is on the operator's word
+            hazard = hazard or bool(self.fault_released & {*a.sections, *b.sections})
             for element in shared(a, b):
                 key = f"shared:{element}:{a.name}:{b.name}"
                 found[key] = Finding(key, "shared", f"the authorities of {a.name} and {b.name} share {element}",
