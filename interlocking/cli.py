@@ -39,16 +39,28 @@ def cmd_table(args: argparse.Namespace) -> int:
     if args.format == "xlsx":
         from .tablexlsx import write_xlsx
 
-        write_xlsx(signed_table(table), Path(args.output))
-        print(f"wrote {args.output}")
-        return 0
+        return _write(Path(args.output), lambda tmp: write_xlsx(signed_table(table), tmp))
     text = {"text": as_text, "csv": as_csv, "json": as_json}[args.format](table)
     if args.format != "csv":
         text += "\n"
     if args.output is None:
         print(text, end="")
-    else:
-        Path(args.output).write_text(text, encoding="utf-8")
+        return 0
+    return _write(Path(args.output), lambda tmp: tmp.write_text(text, encoding="utf-8"))
+
+
+def _write(path: Path, write: Callable[[Path], object]) -> int:
+    """Write through a temporary file beside ``path``, so a failed write leaves no half-written table."""
+    tmp = path.with_name(f".{path.name}.tmp")
+    try:
+        write(tmp)
+        tmp.replace(path)
+    except OSError as exc:
+        tmp.unlink(missing_ok=True)
+        print(f"liansuo table: cannot write {path}: {exc.strerror or exc}; give -o a file in a folder you can write "
+              "to", file=sys.stderr)
+        return 1
+    print(f"wrote {path}")
     return 0
 
 

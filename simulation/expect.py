@@ -6,11 +6,16 @@ Each compares what the world shows now (through its query API) with what the scr
 from __future__ import annotations
 
 from liansuo.interlocking.io import Result
+from liansuo.interlocking.state import RouteStage
 
 from .language import Command
 from .world import World
 
 USAGE = "expect signal|route|turnout|section|refused|accepted|alarm|no-alarm|block-line|code|odometry ..."
+
+
+# the stages of a route (interlocking/state.py) and 'released': what 'expect route' may ask for
+ROUTE_WORDS = (*(stage.value for stage in RouteStage), "released")
 
 
 def _expect(sim: World, args: list[str]) -> Result:
@@ -31,9 +36,12 @@ def _expect(sim: World, args: list[str]) -> Result:
             route_id, want = f"{rest[0]}-{rest[1]}", rest[2]
         if route_id not in sim.table.routes and not any(r.startswith(route_id + "(") for r in sim.table.routes):
             return Result.refuse(f"there is no route {route_id}")
+        if want not in ROUTE_WORDS:
+            return Result.refuse(f"a route is {', '.join(ROUTE_WORDS)}, not '{want}'")
         got = sim.route_state(route_id)
-        ok = got == want or (want == "locked" and got in ("locked", "open", "guide", "closed", "in_use", "time_release")
-                             ) or (want == "open" and got == "guide")
+        # 'locked' holds from locking until release; 'open' holds for the guide aspect too
+        ok = got == want or (want == "locked" and got not in ("setting", "released")) or (
+            want == "open" and got == RouteStage.guide.value)
         return Result(ok, f"route {route_id} is {got}" + ("" if ok else f", expected {want}"))
     if what == "turnout" and len(rest) in (2, 3):
         t, want = rest[0], rest[1]

@@ -114,3 +114,12 @@ def test_a_departure_onto_a_line_with_no_block_described_checks_the_line_section
     d("occupy IAG", "route S3 X", "run 20s", "expect signal S3 H", "expect route S3 X locked")
     d("vacate IAG", "run 1s", "expect signal S3 L")
     d("occupy IAG", "run 1s", "expect signal S3 H")  # and a train running in closes it again
+
+
+def test_expect_route_names_the_stages_a_route_can_be_in() -> None:
+    sim = Simulation("jiaopei")
+    sim.command("route X XI")
+    sim.run(10)
+    assert sim.command("expect route X XI open").ok and sim.command("expect route X XI locked").ok
+    wrong = sim.command("expect route X XI lockd")
+    assert not wrong.ok and "not 'lockd'" in wrong.message and "closed" in wrong.message and "released" in wrong.message

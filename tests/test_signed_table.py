@@ -127,3 +127,16 @@ def test_xlsx_has_every_route_and_the_sign_off_block(tmp_path: Path, capsys: pyt
 def test_xlsx_needs_an_output_file(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["table", "jiaopei", "--format", "xlsx"]) == 2
     assert "-o FILE" in capsys.readouterr().err
+
+
+def test_a_table_that_cannot_be_written_says_so_and_leaves_no_file(tmp_path: Path,
+                                                                   capsys: pytest.CaptureFixture[str]) -> None:
+    for fmt, name in (("xlsx", "t.xlsx"), ("text", "t.txt")):
+        target = tmp_path / "missing-folder" / name
+        assert main(["table", "jiaopei", "--format", fmt, "-o", str(target)]) == 1
+        err = capsys.readouterr().err
+        assert f"cannot write {target}" in err and "Traceback" not in err
+        assert not target.exists() and not target.parent.exists()
+    good = tmp_path / "t.txt"
+    assert main(["table", "jiaopei", "-o", str(good)]) == 0
+    assert "至 IG" in good.read_text(encoding="utf-8") and not list(tmp_path.glob(".*.tmp"))
