@@ -205,6 +205,9 @@ def _neighbour(sim: World, args: list[str]) -> Result:
         return Result.refuse(f"there is no virtual neighbour on block line '{link}'")
     if action not in ("request", "depart", "restore", "accident"):
         return Result.refuse(f"usage: {USAGE['neighbour']}")
+    why = sim.neighbours.refuses(link, action)
+    if why:
+        return Result.refuse(why)
     sim.neighbours.send(link, action)
     return Result.accept(f"neighbour on {link}: {action}")
 

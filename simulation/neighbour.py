@@ -32,6 +32,16 @@ class Neighbours:
     def send(self, link: str, pulse: str) -> None:
         self.by_link[link].outbox.append((self.t, pulse))
 
+    def refuses(self, link: str, action: str) -> str:
+        """Why the neighbour's block machine cannot do ``action`` now ('' when it can): a 64D machine asks to send
+        a train only from its normal state, never while it has accepted ours or ours is on the line."""
+        nb = self.by_link[link]
+        if action == "request" and (nb.accepted or nb.our_train_out):
+            what = "has accepted our train" if nb.accepted else "has our train on the line"
+            return (f"the neighbour on {link} {what}: its block machine asks to send a train only once the line is "
+                    "restored")
+        return ""
+
     def permits(self, link: str) -> bool:
         """The neighbour has accepted our train on ``link`` and it has not departed yet."""
         nb = self.by_link.get(link)

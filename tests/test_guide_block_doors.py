@@ -5,6 +5,7 @@ from __future__ import annotations
 import pytest
 from conftest import Driver
 
+from liansuo.proving.oracle import Watch
 from liansuo.simulation.sim import Simulation
 
 
@@ -124,3 +125,19 @@ def test_departure_aspect_counts_clear_block_sections(gaotie: Driver) -> None:
 
 def test_cab_codes_follow_the_signal_ahead_on_coded_sections(gaotie: Driver) -> None:
     gaotie("route X XI", "run 10s", "expect code IG HU", "route XI XFCK", "run 10s", "expect code IG L")
+
+
+def test_a_neighbour_that_accepted_our_train_cannot_ask_to_send_one() -> None:
+    """Found by the suite's random runs on a fresh clone: the instructor's 'neighbour LINK request' was sent while the
+    neighbour had accepted our train, so the neighbour's side showed the line no longer accepted while our starting
+    signal stayed at L. A 64D machine asks to send a train only from its normal state."""
+    sim = Simulation("jiaopei")
+    watch = Watch(sim)
+    watch.attach()
+    assert sim.command("route XI S").ok and sim.command("block-line SL request").ok
+    sim.run(6)
+    assert sim.view.block_line("SL") == "permitted" and sim.aspect("XI") == "L"
+    refused = sim.command("neighbour SL request")
+    assert not refused.ok and "has accepted our train" in refused.message
+    sim.run(2)
+    assert sim.aspect("XI") == "L" and not watch.violations
