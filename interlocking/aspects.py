@@ -47,13 +47,17 @@ def at_stop_or_dark(aspect: str | None) -> bool:
 def usu_allowed(station: Station, route: Route, rules: RuleSet) -> bool:
     sig = station.signals[route.signal]
     reverse = [t.id for t in route.turnouts if t.role == "route" and t.position is TurnoutPosition.reverse]
-    return sig.usu and bool(reverse) and all(
-        station.turnouts[t].number >= rules.usu_min_turnout_number for t in reverse)
+    return sig.usu and bool(reverse) and all(_usu_turnout(station, t, rules) for t in reverse)
+
+
+def _usu_turnout(station: Station, turnout: str, rules: RuleSet) -> bool:
+    """Its diverging track allows the USU speed (No. 18 and larger, or the file's own ``diverging_speed_kmh``)."""
+    return station.diverging_speed_kmh(turnout, rules.design) >= rules.usu_min_diverging_kmh
 
 
 def onward_allows_usu(station: Station, turnouts: Iterable[RouteTurnout], rules: RuleSet) -> bool:
     """The onward route (of the next signal) runs straight, or diverges over No. 18 or larger turnouts only (技规)."""
-    return all(station.turnouts[t.id].number >= rules.usu_min_turnout_number for t in turnouts
+    return all(_usu_turnout(station, t.id, rules) for t in turnouts
                if t.role == "route" and t.position is TurnoutPosition.reverse)
 
 

@@ -26,6 +26,7 @@ from liansuo.stations.topology import Move, Path
 
 from .aspects import possible_aspects
 from .conflicts import derive_conflicts
+from .overlap import profile_overlap
 from .route import KINDS, FoulingSection, InterlockingTable, Kind, Route, RouteTurnout, RunOn
 
 _AT_SIGHT = (SectionRole.station_track, SectionRole.spur)
@@ -41,6 +42,7 @@ class _Builder:
         self.rules = rules
         self.topo = station.topology
         self.errors: list[Diagnostic] = []
+        self._overlaps: dict[str, tuple[tuple[str, ...], tuple[RouteTurnout, ...], float]] = {}
 
     # ---- routes between buttons ------------------------------------------------------------------------------
     def _train_end(self, node: str, d: Direction) -> tuple[str, str] | None:
@@ -133,6 +135,7 @@ class _Builder:
                 protection[u] = away
 
         for t, pos in turnouts:
+            fouling += self._fouling_tied(t, pos)
             track, node_from = st.leg_track(t, _other(pos).value), t
             joints = 0
             while track not in on_path:
@@ -163,6 +166,28 @@ class _Builder:
                     if far.leg is not None:
                         protect(far.node, far.leg)
         return protection, list(dict.fromkeys(fouling))
+
+    def _fouling_tied(self, turnout: str, pos: TurnoutPosition) -> list[FoulingSection]:
+        """Fouling sections from the fouling points tied to ``turnout`` (``turnout`` + ``tracks`` in the file), for a
+        route over it in ``pos``: where the first joint on the other leg lies nearer the turnout than the fouling
+        point plus the clearance (侵限绝缘), a vehicle standing just beyond that joint fouls the route."""
+        st = self.st
+        design = self.rules.design
+        clearance = design.fouling_clearance_emu_m if st.model.emu else design.fouling_clearance_m
+        at = st.turnouts[turnout].at
+        out: list[FoulingSection] = []
+        for fp in st.model.fouling_points:
+            if fp.turnout != turnout:
+                continue
+            chain = st.fouling_legs(fp).get(_other(pos).value, [])
+            joint = chain[0][1] if chain else None
+            if joint is None or joint not in st.joints:
+                continue
+            if abs(st.joints[joint].at - at) < abs(fp.at - at) + clearance:
+                lo, hi = st.joint_tracks(joint)
+                beyond = hi if lo == chain[0][0] else lo
+                out.append(FoulingSection(st.tracks[beyond].section, turnout, pos))
+        return out
 
     def _guards(self, joint: str, behind: str) -> bool:
         """Does a signal at ``joint`` face movements heading from it towards ``behind`` (so it stops them)?"""
@@ -242,13 +267,18 @@ class _Builder:
 
     def _partners(self, turnouts: Sequence[str], positions: dict[str, TurnoutPosition],
                   skip: set[str]) -> dict[str, TurnoutPosition]:
-        """The crossover partners that move with ``turnouts`` and lie as they do."""
+        """The driven turnouts (带动道岔) of ``turnouts``: the crossover partners that move with them and lie as they
+        do, and the turnouts the station file has a turnout drive when a route sets it (``drives``). A turnout the
+        route itself runs over keeps the route's position."""
         out: dict[str, TurnoutPosition] = {}
         for t in turnouts:
             pair = self.st.turnouts[t].pair
             for partner in self.st.pairs[pair] if pair else []:
                 if partner not in positions and partner not in skip:
                     out.setdefault(partner, positions[t])
+            for d in self.st.turnouts[t].drives:
+                if d.when == positions[t].value and d.turnout not in positions and d.turnout not in skip:
+                    out.setdefault(d.turnout, TurnoutPosition(d.position))
         return out
 
     # ---- approach locking ------------------------------------------------------------------------------------------
@@ -323,7 +353,7 @@ class _Builder:
                 "receiving" if sig.kind is SignalKind.home else "transfer")
         else:
             category = "shunting"
-        ov = next((o for o in st.model.overlaps if o.end_signal == end_signal), None) if kind == "train" else None
+        ov_sections, ov_turnouts, ov_release = self._overlap(end_signal) if kind == "train" else ((), (), 0.0)
         leads_into: str | None = None
         run_on: tuple[RunOn, ...] = ()
         if kind == "shunt" and end_signal is None and end not in st.buttons:
@@ -336,11 +366,32 @@ class _Builder:
             fouling=tuple(f for f in fouling if f.section not in path.sections),
             approach=self._approach(start), end_node=end_node, end_signal=end_signal, beyond=beyond,
             exit_link=exit_link, line_sections=line,
-            overlap_sections=tuple(ov.sections) if ov else (),
-            overlap_turnouts=tuple(RouteTurnout(t.turnout, t.position, "route") for t in ov.turnouts) if ov else (),
-            overlap_release_s=(self.rules.overlap_release_s if ov.release_s is None else ov.release_s) if ov else 0.0,
+            overlap_sections=ov_sections, overlap_turnouts=ov_turnouts, overlap_release_s=ov_release,
             diamonds=diamonds, leads_into=leads_into, run_on=run_on,
         )
+
+    def _overlap(self, end_signal: str | None) -> tuple[tuple[str, ...], tuple[RouteTurnout, ...], float]:
+        """(sections, turnouts, release delay) of the overlap beyond ``end_signal``: the station file's own entry,
+        else the one its profile calls for (:mod:`.overlap`), else none."""
+        if end_signal is None:
+            return (), (), 0.0
+        if end_signal not in self._overlaps:
+            own = next((o for o in self.st.model.overlaps if o.end_signal == end_signal), None)
+            if own is not None:
+                self._overlaps[end_signal] = (
+                    tuple(own.sections), tuple(RouteTurnout(t.turnout, t.position, "route") for t in own.turnouts),
+                    self.rules.overlap_release_s if own.release_s is None else own.release_s)
+            else:
+                found = profile_overlap(self.st, end_signal, self.rules.overlap_gradient_per_mille)
+                if found is None:
+                    self._overlaps[end_signal] = ((), (), 0.0)
+                else:
+                    lie = dict(found.turnouts)
+                    lie.update(self._partners([t for t, _ in found.turnouts], lie, set()))
+                    self._overlaps[end_signal] = (found.sections, tuple(RouteTurnout(t, p, "route")
+                                                                        for t, p in lie.items()),
+                                                  self.rules.overlap_release_s)
+        return self._overlaps[end_signal]
 
     def _link_beyond(self, node: str, d: Direction) -> str | None:
         """The block link reached by going on from ``node`` in direction ``d`` without passing a turnout (or the
@@ -412,6 +463,9 @@ class _Builder:
         if self.errors:
             raise StationError(self.errors)
         derive_conflicts(routes, self.rules)
+        self._add_enemies(routes)
+        if self.errors:
+            raise StationError(self.errors)
         onward: dict[str, list[Route]] = defaultdict(list)
         for r in routes.values():
             if r.kind == "train":
@@ -476,6 +530,31 @@ class _Builder:
                                   f"{r.id}", "")
                         continue
                     r.turnouts = tuple(t for t in r.turnouts if not (t.id == p.turnout and t.role == "protection"))
+
+    def _add_enemies(self, routes: dict[str, Route]) -> None:
+        """The station file's added enemies (``overrides.enemies``), both ways, after the derived ones."""
+        for k, e in enumerate(self.st.model.overrides.enemies):
+            missing = [(key, rid) for key, rid in (("route", e.route), ("enemy", e.enemy)) if rid not in routes]
+            for key, rid in missing:
+                self._err(("overrides", "enemies", k, key), f"added enemy names route '{rid}', which does not exist",
+                          f"routes are named START-END; see 'liansuo table {self.st.id}'")
+            if missing:
+                continue
+            if e.route == e.enemy:
+                self._err(("overrides", "enemies", k, "enemy"), f"route {e.route} is named as its own enemy",
+                          "name two different routes")
+                continue
+            a, b = routes[e.route], routes[e.enemy]
+            if b.id in a.conflicts:
+                self._err(("overrides", "enemies", k, "enemy"), f"routes {a.id} and {b.id} are already enemies "
+                          f"({a.conflicts[b.id]})", "remove this entry; the table derives it")
+                continue
+            why = f"added in the station file: {e.why}"
+            a.conflicts[b.id] = b.conflicts[a.id] = why
+            a.added_enemies.add(b.id)
+            b.added_enemies.add(a.id)
+            a.conditional.pop(b.id, None)
+            b.conditional.pop(a.id, None)
 
     def _err(self, loc: tuple[str | int, ...], msg: str, hint: str) -> None:
         if self.st.source is not None:

@@ -101,11 +101,24 @@ class Operator:
                 if self.il.board.indication(member) == t.position.value:
                     continue
                 why = self.il.locks.why_turnout(member)
-                if why:
+                if why and not self._driven_there(member, t.position.value):
                     return f"{why}; the route needs it {t.position.value}"
                 if not self.il.clear(self.il.turnouts[member].section):
                     return f"turnout {member} cannot move: section {self.il.turnouts[member].section} is occupied"
         return ""
+
+    def _driven_there(self, turnout: str, position: str) -> bool:
+        """Every lock on ``turnout`` is held by a route (or its overlap) that is driving it to ``position`` itself: a
+        compatible route (a through movement over an overlap, say) may then wait for it there."""
+        locks = self.il.locks.turnout_locks(turnout)
+        for lk, _, partner in locks:
+            rs = self.il.routes.get(lk.holder)
+            if lk.hold not in (Hold.route, Hold.overlap) or rs is None:
+                return False
+            wanted = {x.id: x.position.value for x in rs.route.all_turnouts}
+            if wanted.get(partner or turnout, wanted.get(turnout)) != position:
+                return False
+        return bool(locks)
 
     def route_blocker_power_up(self, section: str) -> str:
         return f"section {section} is locked since the interlocking started (上电锁闭): give the power-up release first"
@@ -138,6 +151,8 @@ class Operator:
         shared = sorted(wanted & (held | {f.section for f in rs.route.fouling} | set(rs.route.overlap_sections)))
         if shared:
             return f"section {shared[0]}"
+        if rs.id in r.added_enemies and held:
+            return f"an enemy the station file adds: {r.conflicts[rs.id].removeprefix('added in the station file: ')}"
         track = r.head_on.get(rs.id)
         if track is not None:
             theirs = rs.run_on.leads_into if rs.run_on else rs.route.leads_into

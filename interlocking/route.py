@@ -84,6 +84,7 @@ class Route:
     conflicts: dict[str, str] = field(default_factory=dict)  # route id -> why (always)
     conditional: dict[str, tuple[tuple[Condition, str], ...]] = field(default_factory=dict)  # only when ...
     head_on: dict[str, str] = field(default_factory=dict)  # enemy route -> the track both lead onto
+    added_enemies: set[str] = field(default_factory=set)  # enemies the station file adds (overrides.enemies)
     opposing: tuple[str, ...] = ()
 
     @property

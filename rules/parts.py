@@ -34,12 +34,13 @@ class InterlockingRules(Part):
 
     release_s: dict[str, Seconds]  # manual time release, by route kind (train, shunt)
     section_fault_release_s: Seconds
+    overlap_gradient_per_mille: Annotated[float, Field(ge=0)]  # profile-derived overlap beyond a steeper fall
     overlap_release_s: Seconds  # for an overlap whose station file gives no release_s of its own
     squeeze_alarm_s: Seconds
     turnout_concurrency: Annotated[int, Field(ge=1)]
     turnout_timeout_s: Seconds
     block_pulse_s: Seconds
-    usu_min_turnout_number: Annotated[int, Field(ge=1)]
+    usu_min_diverging_kmh: Annotated[float, Field(gt=0)]  # USU only over turnouts that allow this diverging speed
     guide_close_s: Seconds
     approach_locking: ApproachLocking
     enemy_onto_track: list[tuple[Literal["train", "shunt"], Literal["train", "shunt"]]]
@@ -73,12 +74,18 @@ class DesignRules(Part):
     cab_code_min_time_s: Seconds
     cab_code_margin_m: Metres
     coding_speed_kmh: Annotated[float, Field(gt=0)]
+    diverging_speed_kmh: dict[Annotated[int, Field(ge=1)], Annotated[float, Field(gt=0)]] = Field(min_length=1)
     tuning_area_m: Metres
     tuning_area_tolerance_m: Metres
     tuning_dead_zone_max_m: Metres
     capacitor_min_section_m: Metres
     phase25hz_max_length_m: Metres
     bogie_wheelbase_min_m: Metres
+
+    def turnout_speed_kmh(self, number: int) -> float:
+        """The typical diverging speed of a turnout of this number (the figure of the largest number not above it)."""
+        table = sorted(self.diverging_speed_kmh.items())
+        return next((v for n, v in reversed(table) if n <= number), table[0][1])
 
 
 class MachineSpec(Part):

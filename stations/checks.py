@@ -22,7 +22,7 @@ from .schema import (
     StationFile,
 )
 from .source import Diagnostic, Loc, Source
-from .station import LEGS, Port, parse_port
+from .station import LEGS, Port, Station, parse_port
 
 
 class _Checker:
@@ -51,10 +51,12 @@ class _Checker:
             return self.errors
         self.sections()
         self.pairs()
+        self.drives()
         self.signals()
         self.standalone_buttons()
         self.fouling_points()
         self.diamonds()
+        self.profile()
         self.markers()
         self.platforms()
         self.links()
@@ -243,6 +245,27 @@ class _Checker:
                          f"turnouts {a} and {b} form pair '{pair}' but their reverse legs are not joined",
                          "a crossover pair's reverse legs are connected by the crossover track (through joints only)")
 
+    def drives(self) -> None:
+        """A driven turnout (``drives``) is another declared turnout, not the crossover partner (that one moves
+        anyway), named once per position of the turnout that drives it."""
+        turnouts = {t.id: t for t in self.m.turnouts}
+        for k, t in enumerate(self.m.turnouts):
+            seen: set[tuple[str, str]] = set()
+            for m, d in enumerate(t.drives):
+                loc: Loc = ("turnouts", k, "drives", m, "turnout")
+                other = turnouts.get(d.turnout)
+                if other is None:
+                    self.err(loc, f"turnout {t.id} drives unknown turnout '{d.turnout}'",
+                             "name a turnout listed under 'turnouts:'")
+                elif d.turnout == t.id:
+                    self.err(loc, f"turnout {t.id} drives itself", "name another turnout")
+                elif t.pair is not None and other.pair == t.pair:
+                    self.err(loc, f"turnout {d.turnout} is the crossover partner of {t.id} ({t.pair}); it moves "
+                             "with it anyway", "remove this entry: only a turnout outside the pair is driven")
+                elif (d.turnout, d.when) in seen:
+                    self.err(loc, f"turnout {t.id} drives {d.turnout} twice when {d.when}", "keep one entry")
+                seen.add((d.turnout, d.when))
+
     def _reverse_legs_meet(self, a: str, b: str) -> bool:
         # walk from a.reverse through tracks and joints only
         ports = {t.id: (parse_port(t.start), parse_port(t.end)) for t in self.m.tracks}
@@ -320,19 +343,64 @@ class _Checker:
 
     def fouling_points(self) -> None:
         tracks = {t.id: t for t in self.m.tracks}
+        turnouts = {t.id for t in self.m.turnouts}
+        station: Station | None = None
         for k, f in enumerate(self.m.fouling_points):
-            if f.track not in tracks:
-                self.err(("fouling_points", k, "track"), f"fouling point {f.id} is on unknown track '{f.track}'",
-                         "name a track id listed under 'tracks:'")
+            short, tied = f.track is not None, f.turnout is not None or f.tracks is not None
+            if short == tied:
+                self.err(("fouling_points", k), f"fouling point {f.id} needs either 'turnout' and 'tracks' or the "
+                         "short form 'track'" + (", not both" if short else ""),
+                         "write {id: FP1, turnout: '1', tracks: [NORMAL_SIDE, REVERSE_SIDE], at: POSITION}")
                 continue
-            t = tracks[f.track]
-            xa = self.node_positions[parse_port(t.start).node]
-            xb = self.node_positions[parse_port(t.end).node]
-            if not min(xa, xb) <= f.at <= max(xa, xb):
-                self.err(("fouling_points", k, "at"),
-                         f"fouling point {f.id} at {f.at:g} m is off track '{t.id}' "
-                         f"({min(xa, xb):g}-{max(xa, xb):g} m)",
-                         "a fouling point lies on its track, between the track's two ends")
+            if tied and (f.turnout is None or f.tracks is None):
+                missing = "tracks" if f.tracks is None else "turnout"
+                self.err(("fouling_points", k), f"fouling point {f.id} names its "
+                         f"{'turnout' if missing == 'tracks' else 'tracks'} but not its {missing}",
+                         "a fouling point stands between two tracks that part at one turnout: give both")
+                continue
+            named = [f.track] if f.track is not None else list(f.tracks or [])
+            unknown = [m for m, t in enumerate(named) if t not in tracks]
+            for m in unknown:
+                self.err(("fouling_points", k, "track") if short else ("fouling_points", k, "tracks", m),
+                         f"fouling point {f.id} is on unknown track '{named[m]}'", "name a track id listed under "
+                         "'tracks:'")
+            if f.turnout is not None and f.turnout not in turnouts:
+                self.err(("fouling_points", k, "turnout"), f"fouling point {f.id} names unknown turnout "
+                         f"'{f.turnout}'", "name a turnout listed under 'turnouts:'")
+                continue
+            if unknown:
+                continue
+            for tid in named:
+                t = tracks[tid]
+                xa = self.node_positions[parse_port(t.start).node]
+                xb = self.node_positions[parse_port(t.end).node]
+                if not min(xa, xb) <= f.at <= max(xa, xb):
+                    self.err(("fouling_points", k, "at"),
+                             f"fouling point {f.id} at {f.at:g} m is off track '{t.id}' "
+                             f"({min(xa, xb):g}-{max(xa, xb):g} m)",
+                             "a fouling point lies beside its tracks, between each track's two ends")
+                    break
+            else:
+                if tied:
+                    station = station or Station(self.m)
+                    for m, (leg, chain) in enumerate(station.fouling_legs(f).items()):
+                        if not chain:
+                            self.err(("fouling_points", k, "tracks", m),
+                                     f"fouling point {f.id}: track '{named[m]}' is not reached from the {leg} leg of "
+                                     f"turnout {f.turnout} (across joints only)",
+                                     "list first the track on the normal side, then the one on the reverse side")
+
+    def profile(self) -> None:
+        """Each stretch of the profile runs forwards, and no two stretches overlap."""
+        spans = sorted((g.start, g.end, k) for k, g in enumerate(self.m.profile))
+        for g_start, g_end, k in spans:
+            if g_end <= g_start:
+                self.err(("profile", k, "to"), f"profile stretch {k + 1} runs from {g_start:g} m to {g_end:g} m",
+                         "'to' is the higher position: write each stretch with from < to")
+        for (a0, a1, ka), (b0, _, kb) in pairwise(spans):
+            if b0 < a1 and a1 > a0:
+                self.err(("profile", kb, "from"), f"profile stretch {kb + 1} ({b0:g} m on) overlaps stretch {ka + 1} "
+                         f"(to {a1:g} m)", "give each part of the line one gradient")
 
     def diamonds(self) -> None:
         tracks = {t.id: t for t in self.m.tracks}

@@ -9,7 +9,7 @@ from itertools import pairwise
 
 from liansuo.rules import DesignRules, load_rules
 
-from .schema import CircuitType, Direction, JointKind, SignalKind
+from .schema import CircuitType, Direction, FoulingPoint, JointKind, SignalKind
 from .source import Diagnostic, Loc
 from .station import Station
 
@@ -118,36 +118,99 @@ class _Warner:
         return seen
 
     def fouling(self) -> None:
+        """A train stopped at a starting signal must stand clear of the fouling point ahead of it. A fouling point tied
+        to its turnout is measured along that turnout's legs; one in the short form (a bare track) against the
+        starting signals that can reach its track within a short distance."""
         clearance = self.r.fouling_clearance_emu_m if self.st.model.emu else self.r.fouling_clearance_m
+        for fp in self.st.model.fouling_points:
+            if fp.turnout is None:
+                self._fouling_short(fp, clearance)
+                continue
+            t_at = self.st.turnouts[fp.turnout].at
+            for chain in self.st.fouling_legs(fp).values():
+                joint = chain[0][1] if chain else None
+                if joint not in self.st.joints:
+                    continue
+                j_at = self.st.joints[joint].at
+                towards = Direction.down if t_at > j_at else Direction.up
+                for sig in self.st.signals_at(joint):
+                    if sig.kind is SignalKind.starting and sig.direction is towards:
+                        self._fouling_warn(fp.id, sig.id, abs(j_at - t_at) - abs(fp.at - t_at), clearance)
+
+    def _fouling_short(self, fp: FoulingPoint, clearance: float) -> None:
         reach = 50.0  # how far either way a fouling point is looked for
         for sig in self.st.model.signals:
             if sig.kind is not SignalKind.starting or sig.at not in self.st.joints:
                 continue
             j = self.st.joints[sig.at]
-            ahead = 1.0 if sig.direction is Direction.down else -1.0
-            near = self._tracks_near(j.id, reach)
-            for fp in self.st.model.fouling_points:
-                if fp.track not in near:
-                    continue
-                d = (fp.at - j.at) * ahead
-                if -reach < d < clearance:
-                    self.warn(self.loc("fouling_points", fp.id, "at"),
-                              f"fouling point {fp.id} is {d:.1f} m ahead of the joint of starting signal {sig.id} "
-                              f"(need >= {clearance:g} m)"
-                              + (" : the joint is inside the fouling limit" if d < 0 else ""),
-                              "a train stopped at the signal could foul the throat; move the joint or the signal back")
+            if fp.track not in self._tracks_near(j.id, reach):
+                continue
+            d = (fp.at - j.at) * (1.0 if sig.direction is Direction.down else -1.0)
+            if -reach < d < clearance:
+                self._fouling_warn(fp.id, sig.id, d, clearance)
+
+    def _fouling_warn(self, fp: str, sig: str, d: float, clearance: float) -> None:
+        if d >= clearance:
+            return
+        self.warn(self.loc("fouling_points", fp, "at"),
+                  f"fouling point {fp} is {d:.1f} m ahead of the joint of starting signal {sig} (need >= "
+                  f"{clearance:g} m)" + (" : the joint is inside the fouling limit" if d < 0 else ""),
+                  "a train stopped at the signal could foul the throat; move the joint or the signal back")
 
     def coding(self) -> None:
+        """A coded section must be long enough for the cab signal to read its code at the speed trains pass it:
+        the section's own ``speed_kmh``; else line speed on the main line (the straight way from one end of the
+        station to the other); else, on a side line, the highest diverging speed of the turnouts that lead onto it
+        (a train reaches it over one of them), or the rule set's ``coding_speed_kmh`` where none does."""
+        main = self._main_line()
         for s in self.st.model.sections:
             if not s.coded:
                 continue
-            v = s.speed_kmh or self.r.coding_speed_kmh
+            v, why = self._coding_speed(s.id, s.speed_kmh, main)
             need = min_coded_length(v, self.r)
-            have = self.st.section_length(s.id)
+            have = self.st.section_span(s.id)
             if have < need:
                 self.warn(self.loc("sections", s.id), f"coded section '{s.id}' is {have:.1f} m long; at {v:g} km/h "
-                          f"the cab signal needs >= {need:.2f} m ({self.r.cab_code_min_time_s:g} s * v + "
-                          f"{self.r.cab_code_margin_m:g} m)", "lengthen the section or lower its speed")
+                          f"({why}) the cab signal needs >= {need:.2f} m ({self.r.cab_code_min_time_s:g} s * v + "
+                          f"{self.r.cab_code_margin_m:g} m)", "lengthen the section, or give it the 'speed_kmh' "
+                          "trains really pass it at")
+
+    def _coding_speed(self, section: str, own: float | None, main: set[str]) -> tuple[float, str]:
+        st = self.st
+        line = st.model.line_speed_kmh
+        if own is not None:
+            return own, "its speed_kmh"
+        if any(t in main for t in st.section_tracks[section]):
+            return line, "line speed on the main line"
+        tracks = set(st.section_tracks[section])
+        onto = [t for t in st.turnouts if st.turnout_section.get(t) == section
+                or any(tr in tracks for tr, _ in st.leg_chain(t, "reverse"))]
+        if not onto:
+            return self.r.coding_speed_kmh, "no turnout leads onto it"
+        fastest = max(onto, key=lambda t: st.diverging_speed_kmh(t, self.r))
+        v = min(line, st.diverging_speed_kmh(fastest, self.r))
+        return v, f"side line, over turnout {fastest}"
+
+    def _main_line(self) -> set[str]:
+        """The tracks of the straight way from each boundary (facing turnouts normal), to the far end of the line."""
+        st = self.st
+        out: set[str] = set()
+        for end in st.ends.values():
+            if end.kind.value != "boundary":
+                continue
+            (_, track), = st.node_tracks[end.id]
+            node = end.id
+            while track not in out:
+                out.add(track)
+                far = next(p for p in st.track_ports[track] if p.node != node)
+                if far.node in st.joints:
+                    lo, hi = st.joint_tracks(far.node)
+                    track, node = (hi if lo == track else lo), far.node
+                elif far.node in st.turnouts:
+                    track, node = st.leg_track(far.node, "normal" if far.leg == "point" else "point"), far.node
+                else:
+                    break
+        return out
 
     def carriers(self) -> None:
         for j in self.st.model.joints:

@@ -128,6 +128,15 @@ class Machine(StrEnum):
     S700K = "S700K"
 
 
+class Drive(Strict):
+    """A driven turnout (带动道岔): when a route sets the turnout that names it to ``when``, ``turnout`` is moved to
+    ``position`` with the route and proven there before the signal opens, although the route does not run over it."""
+
+    turnout: Id
+    position: Literal["normal", "reverse"]
+    when: Literal["normal", "reverse"]
+
+
 class Turnout(Strict):
     """A turnout (道岔): its point leg on one side, normal (定位) and reverse (反位) legs on the other."""
 
@@ -137,6 +146,8 @@ class Turnout(Strict):
     machine: Machine
     pair: Id | None = None  # crossover pair moved by one command, e.g. '1/3' (双动道岔)
     trailable: bool = True
+    diverging_speed_kmh: Annotated[float, Field(gt=0, le=250)] | None = None  # 侧向允许速度, when not the number's
+    drives: list[Drive] = Field(default_factory=list)  # 带动道岔 that are not its crossover partner
     draw: Draw | None = None
 
 
@@ -254,11 +265,15 @@ class StandaloneButton(Strict):
 
 
 class FoulingPoint(Strict):
-    """A fouling point (警冲标) on a track."""
+    """A fouling point (警冲标): where two tracks that part at a turnout come so close that a vehicle on one fouls
+    the other. Give its ``turnout`` and the two ``tracks`` it stands between (one reached from the normal leg, one
+    from the reverse leg), or, in the older short form, only the ``track`` it stands by."""
 
     id: Id
-    track: Id
     at: Position
+    turnout: Id | None = None
+    tracks: Annotated[list[Id], Field(min_length=2, max_length=2)] | None = None  # [normal side, reverse side]
+    track: Id | None = None
 
 
 class MarkerKind(StrEnum):
@@ -359,11 +374,21 @@ class ProtectionOverride(Strict):
     position: TurnoutPosition
 
 
+class EnemyOverride(Strict):
+    """Two routes the topology does not make enemies that must never be locked together (an added 敌对进路, for
+    example a receiving route against a shunting route beyond a falling gradient)."""
+
+    route: RouteId
+    enemy: RouteId
+    why: str = Field(default="named in the station file", min_length=1)
+
+
 class Overrides(Strict):
-    """What topology alone cannot decide: extra protection turnouts, routes that must not exist."""
+    """What topology alone cannot decide: extra protection turnouts, added enemies, routes that must not exist."""
 
     protection: list[ProtectionOverride] = Field(default_factory=list)
     remove_protection: list[ProtectionOverride] = Field(default_factory=list)
+    enemies: list[EnemyOverride] = Field(default_factory=list)
     forbid: list[RouteId] = Field(default_factory=list)
 
 
@@ -381,6 +406,18 @@ class Overlap(Strict):
     sections: list[Id] = Field(min_length=1)
     turnouts: list[TurnoutAt] = Field(default_factory=list)
     release_s: Annotated[float, Field(gt=0)] | None = None
+
+
+class Grade(Strict):
+    """One stretch of the station's longitudinal profile (纵断面): its gradient in per mille, positive where the line
+    rises towards increasing positions (the down direction)."""
+
+    start: Position = Field(alias="from")
+    end: Position = Field(alias="to")
+    per_mille: Annotated[float, Field(ge=-60, le=60)]
+
+    model_config = ConfigDict(extra="forbid", strict=True, frozen=True, populate_by_name=True,
+                              allow_inf_nan=False)
 
 
 class StationFile(Strict):
@@ -401,6 +438,7 @@ class StationFile(Strict):
     buttons: list[StandaloneButton] = Field(default_factory=list)
     fouling_points: list[FoulingPoint] = Field(default_factory=list)
     diamonds: list[Diamond] = Field(default_factory=list)
+    profile: list[Grade] = Field(default_factory=list)
     markers: list[Marker] = Field(default_factory=list)
     platforms: list[Platform] = Field(default_factory=list)
     links: list[Link] = Field(default_factory=list)

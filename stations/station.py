@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING
 from .schema import (
     Direction,
     End,
+    FoulingPoint,
     Joint,
     Section,
     SectionRole,
@@ -21,6 +22,8 @@ from .schema import (
 from .source import Diagnostic, Source
 
 if TYPE_CHECKING:
+    from liansuo.rules import DesignRules
+
     from .topology import Topology
 
 LEGS = ("point", "normal", "reverse")
@@ -163,6 +166,39 @@ class Station:
             if lg == leg:
                 return tid
         raise KeyError(f"{turnout}.{leg}")
+
+    def leg_chain(self, turnout: str, leg: str, reach: float = 250.0) -> list[tuple[str, str]]:
+        """The tracks from a turnout's ``leg`` away from it across joints only, each as (track, node at its far
+        end), up to another turnout, an end, or the first node more than ``reach`` metres from the turnout."""
+        out: list[tuple[str, str]] = []
+        track, near, at = self.leg_track(turnout, leg), turnout, self.turnouts[turnout].at
+        for _ in range(100):
+            a, b = self.track_ports[track]
+            far = b.node if a.node == near else a.node
+            out.append((track, far))
+            if far not in self.joints or abs(self.node_at(far) - at) > reach:
+                break
+            lo, hi = self.joint_tracks(far)
+            track, near = (hi if lo == track else lo), far
+        return out
+
+    def fouling_legs(self, fp: FoulingPoint) -> dict[str, list[tuple[str, str]]]:
+        """A fouling point tied to its turnout: for each leg (normal, reverse), the chain of tracks from that leg up to
+        the track the fouling point stands beside (:meth:`leg_chain`); {} for the short form (a bare track)."""
+        if fp.turnout is None or fp.tracks is None:
+            return {}
+        out: dict[str, list[tuple[str, str]]] = {}
+        for leg, track in zip(("normal", "reverse"), fp.tracks, strict=True):
+            chain = self.leg_chain(fp.turnout, leg)
+            ids = [t for t, _ in chain]
+            out[leg] = chain[:ids.index(track) + 1] if track in ids else []
+        return out
+
+    def diverging_speed_kmh(self, turnout: str, design: DesignRules) -> float:
+        """The speed a turnout allows over its diverging track: the file's own figure, else the rule set's typical
+        one for its number."""
+        t = self.turnouts[turnout]
+        return t.diverging_speed_kmh if t.diverging_speed_kmh is not None else design.turnout_speed_kmh(t.number)
 
     def turnout_points_down(self, turnout: str) -> bool:
         """True when a down movement runs point -> normal/reverse (facing for down trains)."""

@@ -170,7 +170,7 @@ def test_a_lone_yellow_over_a_diverging_route_is_too_permissive() -> None:
 def test_usu_over_an_onward_route_on_no12_turnouts_is_caught() -> None:
     lines = ("line-direction SL-II out", "route X X3", "route X3 XFK2", "run 20s")
     watch = run_lines(SHUANGXIAN, *lines, mutant="usu-without-onward-check")
-    assert any("X3 is open over turnout 2 reversed (No. 12)" in v.text for v in watch.violations)
+    assert any("X3 is open over turnout 2 reversed (45 km/h)" in v.text for v in watch.violations)
     assert run_lines(SHUANGXIAN, *lines).violations == []
 
 

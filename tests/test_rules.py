@@ -61,7 +61,7 @@ def test_bad_rule_data_names_file_line_and_what_is_wrong(folder: Path) -> None:
     with pytest.raises(RuleError) as exc:
         load_rules(str(folder))
     text = str(exc.value)
-    for want in ("interlocking.yaml:10:22: error: turnout_concurrency: Input should be greater than or equal to 1",
+    for want in ("interlocking.yaml:11:22: error: turnout_concurrency: Input should be greater than or equal to 1",
                  "aspects.yaml:15:8: error: 'BH' is no aspect of this rule set",
                  "lamp 'Q' has no colour", "'B' with 'B' dark shows 'L', which is not more restrictive",
                  "driving.yaml:8:7: error: 'UX' is no aspect", "equipment.yaml:", "unknown key 'dors'"):

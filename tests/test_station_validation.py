@@ -260,7 +260,7 @@ BROKEN = [
            "button SBA (exit) is at 'B-9', which is not a joint or an end", "B-9"),
     Broken("fouling point off its track", edit(BASE, ("{id: FP1, track: t-1b, at: 290}",
                                                       "{id: FP1, track: t-1b, at: 390}")),
-           "fouling point FP1 at 390 m is off track 't-1b' (250-300 m)", "390}", ("between the track's two ends",)),
+           "fouling point FP1 at 390 m is off track 't-1b' (250-300 m)", "390}", ("between each track's two ends",)),
     Broken("fouling point on an unknown track", edit(BASE, ("track: t-1b", "track: t-9")),
            "fouling point FP1 is on unknown track 't-9'", "t-9", ("tracks:",)),
     Broken("platform on a non-station track", edit(BASE, ("{id: P1, section: IG", "{id: P1, section: 3G")),
@@ -366,8 +366,13 @@ WARNED = [
            ("'J-X' and 'J-13'", "only 14.0 m apart", f">= {R.dead_zone_spacing_min_m:g} m",
             f">= {R.dead_zone_spacing_relaxed_m:g} m", f"under {R.dead_zone_short_m:g} m"), "255, at2"),
     Warned("coded section too short", edit(BASE, ("{id: J-XI, at: 900}", "{id: J-XI, at: 340}")),
-           ("coded section 'IG'", "40.0 m long", f"at {R.coding_speed_kmh:g} km/h",
-            f">= {min_coded_length(R.coding_speed_kmh):.2f} m", "51.25 m"), "{id: IG, type"),
+           ("coded section 'IG'", "40.0 m long", "at 80 km/h (line speed on the main line)",
+            f">= {min_coded_length(80):.2f} m", "75.56 m"), "{id: IG, type"),
+    Warned("coded siding too short at the rule set's speed",
+           edit(BASE, ("{id: 3G, type: 25hz, role: spur}", "{id: 3G, type: 25hz, role: spur, coded: true}"),
+                ("{id: B-3, kind: buffer, at: 600}", "{id: B-3, kind: buffer, at: 350}")),
+           ("coded section '3G'", "40.0 m long", f"at {R.turnout_speed_kmh(12):g} km/h (side line, over turnout 1)",
+            f">= {min_coded_length(R.turnout_speed_kmh(12)):.2f} m", "51.25 m"), "{id: 3G, type"),
     Warned("same carrier on both sides of a joint",
            edit(BASE, ("{id: IAG, type: 25hz, role: approach}",
                        "{id: IAG, type: zpw2000a, carrier: 2300-1, role: approach}"),
@@ -588,7 +593,8 @@ def test_format_doc_lists_every_design_rule_and_enum_value() -> None:
     rules = ROOT / "rules" / "china" / "design.yaml"
     for key, value in yaml.safe_load(rules.read_text(encoding="utf-8")).items():
         assert f"`{key}`" in doc, key
-        assert f"{value:g}" in doc, (key, value)
+        for number, figure in (value.items() if isinstance(value, dict) else [("", value)]):
+            assert f"{number}: {figure:g}" in doc if number else f"{figure:g}" in doc, (key, number, figure)
     for enum in (schema.EndKind, schema.JointKind, schema.Machine, schema.CircuitType, schema.SectionRole,
                  schema.SignalKind, schema.Lamp, schema.Button, schema.LinkKind, schema.Side, schema.Direction):
         for member in enum:

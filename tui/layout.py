@@ -365,7 +365,8 @@ def _paint(b: _Builder, col: list[int], lay: Layout) -> None:
             lay.section_cells.setdefault(sec, []).append((x, y))
     _paint_nodes(b, lay, cx, cy)
     for fp in st.model.fouling_points:
-        x, y = col[b.index[b._p(fp.at)]], b.line(b.rows[fp.track])
+        track = fp.track if fp.track is not None else (fp.tracks or [""])[0]  # tied: drawn by the normal-side track
+        x, y = col[b.index[b._p(fp.at)]], b.line(b.rows[track])
         g = lay.at(x, y)
         if g is not None and g.role == "band":
             _put(lay, x, y, Glyph(FOULING, "fp", Ref("fouling", fp.id), g.section))

@@ -25,6 +25,8 @@ from typing import Literal
 from liansuo.stations.schema import Direction, SectionRole, SignalKind
 from liansuo.stations.station import Station
 
+from .gradient import steep_overlaps
+
 Kind = Literal["train", "shunt"]
 Lies = Callable[[str], "str | None"]  # turnout -> where its switch rails lie ('normal', 'reverse' or None)
 
@@ -76,16 +78,24 @@ class Authority:
 class Tracer:
     """Traces authorities over one station."""
 
-    def __init__(self, station: Station, *, overlap_release_s: float = 0.0) -> None:
+    def __init__(self, station: Station, *, overlap_release_s: float = 0.0,
+                 overlap_gradient_per_mille: float | None = None) -> None:
         """``overlap_release_s``: the rule set's overlap release time, for an overlap whose station file gives none
-        (only an oracle that times overlaps needs it)."""
+        (only an oracle that times overlaps needs it); ``overlap_gradient_per_mille``: the fall beyond an end signal
+        that calls for an overlap where the file gives none (None: only the file's overlaps)."""
         self.st = station
         self.overlap_release_s = overlap_release_s
         self.topo = station.topology
         self.role = {s: sec.role for s, sec in station.sections.items()}
         self.section_of = {t: tr.section for t, tr in station.tracks.items()}
         self.link_at = {lk.end: lk.id for lk in station.model.links}
-        self.overlaps = {o.end_signal: o for o in station.model.overlaps}
+        self.overlaps: dict[str, tuple[tuple[str, ...], dict[str, str], float]] = {}
+        if overlap_gradient_per_mille is not None:
+            for end, (sections, lie) in steep_overlaps(station, overlap_gradient_per_mille).items():
+                self.overlaps[end] = (sections, lie, overlap_release_s)
+        for o in station.model.overlaps:  # the file's own overlap replaces one the profile calls for
+            self.overlaps[o.end_signal] = (tuple(o.sections), {t.turnout: t.position.value for t in o.turnouts},
+                                           o.release_s if o.release_s is not None else overlap_release_s)
         # the port of a track at a turnout: (track, turnout) -> leg
         self.leg_at: dict[tuple[str, str], str] = {}
         for tid, ports in station.track_ports.items():
@@ -135,10 +145,8 @@ class Tracer:
                     a.against.append(far)
                 track = st.leg_track(far, "point")
         if kind == "train" and a.end == "signal" and a.end_signal in self.overlaps:
-            ov = self.overlaps[a.end_signal]
-            a.overlap_sections = tuple(ov.sections)
-            a.overlap_turnouts = {t.turnout: t.position.value for t in ov.turnouts}
-            a.overlap_release_s = ov.release_s if ov.release_s is not None else self.overlap_release_s
+            a.overlap_sections, turnouts, a.overlap_release_s = self.overlaps[a.end_signal]
+            a.overlap_turnouts = dict(turnouts)
         return a
 
     def _add(self, a: Authority, track: str) -> None:

@@ -5,7 +5,7 @@ movement is about to run:
 
 - a signal whose path runs over a turnout in its reverse position (diverging) shows at most two yellows (UU); the
   flashing yellow over yellow (USU) only when every diverging turnout of the path is No. 18 or larger (the rule
-  set's ``usu_min_turnout_number``), the signal has a flasher, and the next signal is open over a path that is
+  set's ``usu_min_diverging_kmh``), the signal has a flasher, and the next signal is open over a path that is
   straight or diverges over No. 18 or larger turnouts only. Only home and route signals tell the diverging route:
   a starting signal's aspect counts the block sections ahead, whatever its path;
 - on a straight path a signal shows at most what the next signal allows: green (L) when the next shows green,
@@ -62,7 +62,12 @@ class Ceiling:
     def __init__(self, station: Station, rules: RuleSet) -> None:
         self.st = station
         self.a = rules.aspects
-        self.usu_min = rules.usu_min_turnout_number
+        self.usu_min = rules.usu_min_diverging_kmh
+        # the speed each turnout allows over its diverging track: the station file's figure, else the rule set's
+        # typical figure for its number (the largest number listed not above it)
+        table = sorted(rules.design.diverging_speed_kmh.items(), reverse=True)
+        self.speed = {t.id: t.diverging_speed_kmh if t.diverging_speed_kmh is not None else
+                      next((v for n, v in table if n <= t.number), table[-1][1]) for t in station.model.turnouts}
         self.semi_auto = rules.aspects.semi_auto_departure
         self.links = {lk.id: lk for lk in station.model.links}
         # diverging: the steady aspect (two yellows), and the flashing one over No. 18+ turnouts where it may show
@@ -91,20 +96,20 @@ class Ceiling:
 
     def _diverging(self, a: Authority, reverse: list[str], ahead: str, ahead_path: Authority | None) -> Limit:
         most, flashing = self.diverging, self.diverging_flashing
-        small = [t for t in reverse if self.st.turnouts[t].number < self.usu_min]
+        small = [t for t in reverse if self.speed[t] < self.usu_min]
         if small:
-            return Limit(most, f"diverging over turnout {small[0]} (No. {self.st.turnouts[small[0]].number})")
+            return Limit(most, f"diverging over turnout {small[0]} ({self.speed[small[0]]:g} km/h)")
         if not self.st.signals[a.signal].usu:
             return Limit(most, f"diverging; {a.signal} has no flashing yellow")
         if ahead not in self.a.train_proceed or ahead_path is None:
             return Limit(most, f"diverging; the next signal {a.end_signal or '-'} is not open")
         onward = [t for t, pos in ahead_path.turnouts.items()
-                  if pos == "reverse" and self.st.turnouts[t].number < self.usu_min]
+                  if pos == "reverse" and self.speed[t] < self.usu_min]
         if onward:
             return Limit(most, f"the next signal {a.end_signal} is open over turnout {onward[0]} reversed "
-                               f"(No. {self.st.turnouts[onward[0]].number})")
-        return Limit(flashing, f"diverging over No. {self.usu_min}+ turnouts, {a.end_signal} open straight or over "
-                               f"No. {self.usu_min}+")
+                               f"({self.speed[onward[0]]:g} km/h)")
+        return Limit(flashing, f"diverging over turnouts for {self.usu_min:g} km/h, {a.end_signal} open straight "
+                               f"or over such turnouts")
 
     def _line(self, a: Authority, view: FieldView) -> Limit:
         assert a.link is not None

@@ -26,7 +26,7 @@ from liansuo.stations.station import Station
 
 from .authority import Authority, Tracer
 from .ceiling import Ceiling, permits
-from .flank import Demand, Flank
+from .flank import Demand, Flank, clearance_m
 from .lamps import UNDEFINED, LampReader
 from .meet import Extent, head_on, shared
 from .view import FieldView
@@ -71,8 +71,9 @@ class _Held(Extent):
 class Oracle:
     def __init__(self, station: Station, rules: RuleSet, *, cycle_s: float = 0.25, reaction: int = 2) -> None:
         self.st = station
-        self.tracer = Tracer(station, overlap_release_s=rules.overlap_release_s)
-        self.flank = Flank(station)
+        self.tracer = Tracer(station, overlap_release_s=rules.overlap_release_s,
+                             overlap_gradient_per_mille=rules.overlap_gradient_per_mille)
+        self.flank = Flank(station, clearance_m(station, rules))
         self.aspects = rules.aspects
         self.reader = LampReader(rules.aspects)
         self.ceiling = Ceiling(station, rules)

@@ -17,6 +17,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
+from liansuo.rules import RuleSet
 from liansuo.stations.schema import Direction, SectionRole
 from liansuo.stations.station import Station
 
@@ -32,11 +33,23 @@ class Demand:
     why: str
 
 
+def clearance_m(station: Station, rules: RuleSet) -> float:
+    """How far past a fouling point a vehicle must stand to be clear of it (more where EMUs call)."""
+    return rules.design.fouling_clearance_emu_m if station.model.emu else rules.design.fouling_clearance_m
+
+
 class Flank:
-    def __init__(self, station: Station) -> None:
+    def __init__(self, station: Station, clearance_m: float) -> None:
         self.st = station
         self.role = {t: station.sections[tr.section].role for t, tr in station.tracks.items()}
-        self.fouled = {fp.track for fp in station.model.fouling_points}
+        self.fouled = {fp.track for fp in station.model.fouling_points if fp.track is not None}
+        # turnout -> how far along its legs the fouling limit reaches: a tied fouling point's distance from the
+        # turnout, plus the clearance a vehicle needs past it
+        self.limit: dict[str, float] = {}
+        for fp in station.model.fouling_points:
+            if fp.turnout is not None:
+                reach = abs(fp.at - station.turnouts[fp.turnout].at) + clearance_m
+                self.limit[fp.turnout] = max(reach, self.limit.get(fp.turnout, 0.0))
         self._cache: dict[tuple[str, ...], tuple[dict[str, Demand], list[str]]] = {}
 
     def of(self, tracks: Sequence[str], turnouts: Mapping[str, str]) -> tuple[dict[str, Demand], list[str]]:
@@ -123,7 +136,9 @@ class Flank:
             track, node_from = (hi if lo == track else lo), far.node
 
     def _fouling(self, track: str, turnout: str) -> str | None:
-        """The section past the first joint on a free leg, when the leg's fouling point lies beyond that joint."""
+        """The section past the first joint on a free leg, when that joint lies inside the turnout's fouling limit:
+        a fouling point beyond the joint, or the joint nearer the turnout than its tied fouling point plus the
+        clearance."""
         st = self.st
         node_from = turnout
         while True:
@@ -134,5 +149,6 @@ class Flank:
             lo, hi = st.joint_tracks(far.node)
             beyond = hi if lo == track else lo
             if st.tracks[beyond].section != st.tracks[track].section:
-                return st.tracks[beyond].section if beyond in self.fouled else None
+                inside = abs(st.node_at(far.node) - st.node_at(turnout)) < self.limit.get(turnout, 0.0)
+                return st.tracks[beyond].section if beyond in self.fouled or inside else None
             track, node_from = beyond, far.node

@@ -20,7 +20,7 @@ from liansuo.rules import RuleSet
 from liansuo.stations.station import Station
 
 from .authority import Authority, Kind, Tracer, other
-from .flank import Demand, Flank
+from .flank import Demand, Flank, clearance_m
 from .meet import Extent, head_on, shared
 
 
@@ -37,8 +37,8 @@ class RouteSpec:
 class PaperOracle:
     def __init__(self, station: Station, rules: RuleSet) -> None:
         self.st = station
-        self.tracer = Tracer(station)
-        self.flank = Flank(station)
+        self.tracer = Tracer(station, overlap_gradient_per_mille=rules.overlap_gradient_per_mille)
+        self.flank = Flank(station, clearance_m(station, rules))
         self.enemies = [frozenset(pair) for pair in rules.enemy_onto_track]
         self.partners: dict[str, list[str]] = {}
         for members in station.pairs.values():
