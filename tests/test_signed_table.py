@@ -18,7 +18,7 @@ from liansuo.interlocking.signedtable import Row, signed_table
 from liansuo.interlocking.table import build_table
 from liansuo.interlocking.tableformat import as_csv, as_json, as_text
 from liansuo.interlocking.tableschema import TABLE_SCHEMA
-from liansuo.stations.loader import load
+from liansuo.stations.loader import load, load_text
 
 
 def width(line: str) -> int:
@@ -124,6 +124,26 @@ def test_xlsx_has_every_route_and_the_sign_off_block(tmp_path: Path, capsys: pyt
     assert seen == set(table.routes)
 
 
+@pytest.mark.parametrize("station", ["jiaopei", "gaotie", "depot"])
+def test_xlsx_opens_in_another_reader_with_every_route(tmp_path: Path, station: str) -> None:
+    """Read back by calamine (a Rust reader of spreadsheet files, not the library that wrote it): every sheet opens
+    and every route of the table stands on one, under its number."""
+    from python_calamine import CalamineWorkbook
+
+    out = tmp_path / f"{station}.xlsx"
+    assert main(["table", station, "--format", "xlsx", "-o", str(out)]) == 0
+    signed = signed_table(build_table(load(station)))
+    wb = CalamineWorkbook.from_path(str(out))
+    assert wb.sheet_names == [g.name for g in signed.groups]
+    listed = {str(r.cells["no"]): r.route for g in signed.groups for r in g.rows}
+    seen = set()
+    for name in wb.sheet_names:
+        rows = [[str(c) for c in row] for row in wb.get_sheet_by_name(name).to_python()]
+        assert rows[1][:2] == ["序号", "进路"] and name in rows[0][0]
+        seen |= {listed[row[0]] for row in rows[2:] if row and row[0] in listed}
+    assert seen == set(build_table(load(station)).routes)
+
+
 def test_xlsx_needs_an_output_file(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["table", "jiaopei", "--format", "xlsx"]) == 2
     assert "-o FILE" in capsys.readouterr().err
@@ -140,3 +160,17 @@ def test_a_table_that_cannot_be_written_says_so_and_leaves_no_file(tmp_path: Pat
     good = tmp_path / "t.txt"
     assert main(["table", "jiaopei", "-o", str(good)]) == 0
     assert "至 IG" in good.read_text(encoding="utf-8") and not list(tmp_path.glob(".*.tmp"))
+
+
+def test_a_route_signal_gives_a_transfer_group_between_receiving_and_departure() -> None:
+    """A route signal (进路信号机) inside the station splits the movement: X receives up to it, and the route from it
+    onto the track is a transfer (转线), grouped after the departures of its direction and named by its tracks."""
+    text = (Path(__file__).resolve().parent.parent / "examples" / "stations" / "minimal.yaml").read_text("utf-8")
+    text = text.replace("  - {id: XI, kind: starting", "  - {id: XL1, kind: route, at: J-1I, direction: down, "
+                        "lamps: [U, L, H], buttons: [train]}\n  - {id: XI, kind: starting", 1)
+    signed = signed_table(build_table(load_text(text, "m.yaml")))
+    groups = [(g.name.split()[0], [r.route for r in g.rows]) for g in signed.groups]
+    assert groups == [("下行接车", ["X-XL1"]), ("下行发车", ["XI-SBA"]), ("下行转线", ["XL1-XI"])]
+    transfer = signed.groups[-1].rows[0]
+    assert transfer.cells["route"] == "由 XL1 至 IG" and transfer.cells["signal"] == "XL1"
+    assert "转线" in as_text(build_table(load_text(text, "m.yaml")))
