@@ -56,7 +56,7 @@ class Traversal:
             seq.append(route.beyond)
         self.seq = list(dict.fromkeys(seq))
         verb = "route" if route.kind == "train" else "shunt"
-        self.command = " ".join([verb, route.start, *route.via, route.end])
+        self.command = " ".join([verb, *route.buttons])
         self.state = "idle"
         self.head = self.tail = -1
         self.next_tick = 0

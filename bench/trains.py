@@ -84,7 +84,7 @@ class _Dispatcher:
         return ok
 
     def _route(self, r: Route) -> str:
-        return " ".join(["route", r.start, *r.via, r.end])
+        return " ".join(["route", *r.buttons])
 
     def tick(self) -> None:
         sim = self.sim

@@ -31,6 +31,8 @@ KINDS: dict[str, FaultKind] = {k.name: k for k in [
     FaultKind("insulation", "joint-or-turnout", {}, "failed insulation at an insulated joint or at a switch machine"),
     FaultKind("capacitor", "section", {"n": 1.0, "mode": "open"}, "a ZPW-2000A compensation capacitor fails",
               {"mode": ("open", "half", "short")}),
+    FaultKind("axle-miscount", "section", {},
+              "an axle counter miscounts (计轴故障): the section shows occupied until the count is reset (计轴复零)"),
     FaultKind("filament", "signal", {"lamp": "", "which": "both"}, "lamp filament broken (灯丝断丝)",
               {"which": ("main", "backup", "both")}),
     FaultKind("flasher", "signal", {"mode": "bad-contact"}, "USU flasher fault: bad SNJ contact",
@@ -112,6 +114,8 @@ def parse_fault(station: Station, kind_name: str, target: str, args: list[str]) 
             return f"fault filament: name the lamp with lamp=..., one of {', '.join(lamps)}"
     if kind_name == "flasher" and not station.signals[target].usu:
         return f"fault flasher: signal {target} has no USU flasher"
+    if kind_name == "axle-miscount" and station.sections[target].type.value != "axle_counter":
+        return f"fault axle-miscount: section {target} is a track circuit, not counted by axle counters"
     if kind_name == "capacitor":
         sec = station.sections[target]
         if sec.type.value != "zpw2000a":

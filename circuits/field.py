@@ -35,6 +35,7 @@ class FieldCommands:
     changed_signals: set[str] = field(default_factory=set)  # signals whose lamps or flashing changed
     doors: dict[str, tuple[bool, bool, bool]] = field(default_factory=dict)  # key -> (ZCKJ, KMJ, GMJ)
     cab_codes: dict[str, str | None] = field(default_factory=dict)
+    axle_resets: set[str] = field(default_factory=set)  # axle-counter sections to reset (计轴复零), taken once
 
 
 @dataclass
@@ -150,6 +151,12 @@ class Field:
             if (d.pdkj, d.pdqcj) != before:
                 self._changes.doors.add(key)
         self.cab_codes = cmd.cab_codes
+        for sec in cmd.axle_resets:
+            counter = self.circuits[sec].counter
+            if counter is not None:
+                counter.reset(self.circuits[sec].inside)
+                self._reevaluate(sec)
+        cmd.axle_resets.clear()
 
     def _relight(self, signal: str, lit: set[str]) -> None:
         before = self.lamps[signal].proving()
@@ -249,6 +256,12 @@ class Field:
                 else:
                     sf.capacitors.pop(n, None)
             self._reevaluate(t)
+        elif k == "axle-miscount":
+            # the count stays wrong after the head is repaired, until the operator resets it (计轴复零)
+            counter = self.circuits[t].counter
+            if on and counter is not None:
+                counter.miscount()
+                self._reevaluate(t)
         elif k == "insulation":
             if t in self.station.turnouts:
                 self.machines[t].faults.insulation = on

@@ -4,6 +4,8 @@
 returns the track relay (GJ) state with the model's hysteresis. The teaching base's switch K (``occupy``) forces the
 relay down. Faults a section can carry: broken rail, poor shunt (wheelsets shunt through a higher resistance), low
 ballast, failed insulation (at an insulated joint or a switch machine), and on ZPW-2000A compensation capacitors.
+A section of ``type: axle_counter`` has an axle counter (:mod:`.axlecounter`) instead: it counts wheelsets, so those
+faults do not touch it; its own fault is a miscount, and its count is reset by the operator (计轴复零).
 """
 
 from __future__ import annotations
@@ -14,6 +16,7 @@ from dataclasses import dataclass, field
 from liansuo.stations.schema import CircuitType
 from liansuo.stations.station import Station
 
+from .axlecounter import AxleCounter
 from .phase25hz import Phase25HzCircuit, Phase25HzFaults, adjusted_params
 
 
@@ -46,6 +49,7 @@ class SectionCircuit:
         self._voltage = 0.0  # V for 25 Hz, mV for ZPW-2000A
         self._cab_current_mA: float | None = None
         self._stale: Sequence[tuple[float, float]] | None = None  # shunts not yet solved for (see ``update``)
+        self._inside = 0  # wheelsets on the section at the last update (what an axle counter counts)
         # every model is adjusted so that one standard shunt anywhere drops its relay (25 Hz: residual <= 7.4 V
         # with 0.06 ohm, below the relay's drop level; ZPW-2000A: < 153 mV with 0.15 ohm), as their tests assert
         self.standard_shunt_ohm = 0.06 if kind is CircuitType.phase25hz else 0.15
@@ -68,8 +72,27 @@ class SectionCircuit:
             self._evaluate(shunts)
             self.up = up
 
+    @property
+    def axle_count(self) -> int | None:
+        """An axle counter's count (None for a track circuit)."""
+        return self.model.count(self._inside) if isinstance(self.model, AxleCounter) else None
+
+    @property
+    def counter(self) -> AxleCounter | None:
+        """The axle counter of an axle-counter section (None on a track circuit); re-evaluate after changing it."""
+        return self.model if isinstance(self.model, AxleCounter) else None
+
+    @property
+    def inside(self) -> int:
+        """Wheelsets on the section at the last update."""
+        return self._inside
+
     def update(self, shunts: Sequence[tuple[float, float]]) -> bool:
         f = self.faults
+        self._inside = len(shunts)
+        if isinstance(self.model, AxleCounter):
+            self.up = self.model.clear(self._inside) and not self.k_switch
+            return self.up
         if shunts and not f.any() and min(r for _, r in shunts) <= self.standard_shunt_ohm:
             # a healthy circuit with a standard (or better) shunt on it: down by design; solve only if asked
             self._stale = list(shunts)
@@ -113,6 +136,8 @@ def _clip(at: float | None, length: float) -> float | None:
 
 def build_circuit(station: Station, section: str, length_m: float) -> SectionCircuit:
     sec = station.sections[section]
+    if sec.type is CircuitType.axle_counter:
+        return SectionCircuit(section, sec.type, length_m, AxleCounter())
     if sec.type is CircuitType.phase25hz:
         params = adjusted_params(max(length_m, 1.0))
         return SectionCircuit(section, sec.type, length_m, Phase25HzCircuit(max(length_m, 1.0), params))

@@ -84,8 +84,8 @@ def possible_aspects(station: Station, route: Route, rules: RuleSet | None = Non
     diverging = any(t.role == "route" and t.position is TurnoutPosition.reverse for t in route.turnouts)
     if route.category == "departure":
         link = next((lk for lk in station.model.links if lk.id == route.exit_link), None)
-        if link is not None and link.kind.value == "64d":
-            return (rules.semi_auto_departure,)
+        if link is not None and link.kind.value in ("64d", "station"):
+            return (rules.semi_auto_departure,)  # no block signals: the whole line is clear, or the signal at stop
         if link is not None and station.link_running(link.id) == "inbound":
             return ("L",)  # against the running direction, after 改方: the whole line is one block
         return ("L", "LU", "U")
@@ -105,7 +105,7 @@ def select_aspect(station: Station, route: Route, next_aspect: str, clear_blocks
     """The aspect to show for an open route.
 
     ``next_aspect``: the aspect of the signal at the end of the route ('' if none).
-    ``clear_blocks``: clear automatic block sections ahead of a departure (None on 64D lines).
+    ``clear_blocks``: clear automatic block sections ahead of a departure (None on 64D and station-block lines).
     ``usu_ready``: the onward route is open, straight or over No. 18+ turnouts, and the flasher is healthy.
     """
     rules = rules or load_rules()

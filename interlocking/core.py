@@ -23,7 +23,8 @@ from .block64d import BlockLink, line_pulses_in, line_tracks_changed
 from .io import Alarm, DoorCommand, Event, Outputs, RelayBoard
 from .locks import Hold, LockLedger
 from .route import InterlockingTable, Route
-from .state import GuideOnly, RouteState, SignalState, TurnoutState
+from .state import GuideOnly, RouteStage, RouteState, SignalState, TurnoutState
+from .stationblock import StationBlockLink
 
 MAX_EVENTS = 20_000
 # sections the interlocking locks at power-up (上电锁闭): all of the station's own, not the lines'
@@ -67,6 +68,9 @@ class Core:
         self.links = {lk.id: BlockLink(lk.id, lk.sections[0] if lk.sections else "")
                       for lk in st.model.links if lk.kind.value == "64d"}
         self.auto_links = {lk.id: tuple(lk.sections) for lk in st.model.links if lk.kind.value == "automatic"}
+        self.station_links = {lk.id: StationBlockLink(lk.id, tuple(lk.sections))
+                              for lk in st.model.links if lk.kind.value == "station"}
+        self.axle_resets_used = 0  # the sealed axle-counter reset button's counter (计轴复零)
         self.line_out: set[str] = set()  # automatic lines whose direction is changed for our departures (改方)
         self.queue: deque[str] = deque()
         self.moving: set[str] = set()
@@ -127,11 +131,15 @@ class Core:
         return Changes(tracks, turnouts, signals, pulses, commanded)
 
     def apply_inputs(self, ch: Changes) -> None:
-        """The 64D line, turnout indications, lamp proving and the turnout move queue."""
+        """The 64D and station-block lines, turnout indications, lamp proving and the turnout move queue."""
         for link, msgs in ch.pulses.items():
             line_pulses_in(self.links, link, msgs, self.event)
         if ch.tracks and self.links:
             line_tracks_changed(self.links, ch.tracks, self.clear, self.send, self.event)
+        for sl in self.station_links.values():
+            departing = any(rs.route.exit_link == sl.id and rs.stage is not RouteStage.setting
+                            for rs in self.routes.values())
+            sl.step(departing, self.clear, ch.pulses.get(sl.id, ()), self.send, self.event)
         for t_id in ch.turnouts:
             if self.board.indication(t_id) is None:
                 if t_id not in self.no_indication:
@@ -306,6 +314,10 @@ class Core:
                 return f"block line {link.id} has not been accepted by the neighbour station (64D: {link.state.value})"
             if not self.clear(link.departure_section):
                 return f"departure section {link.departure_section} is occupied"
+        if r.exit_link in self.station_links:
+            why = self.station_links[r.exit_link].blocker(self.clear)
+            if why:
+                return why
         if r.exit_link in self.auto_links:
             why = self.against_running(r.exit_link)
             if why:

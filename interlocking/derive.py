@@ -14,6 +14,7 @@ from __future__ import annotations
 
 from collections import defaultdict
 from collections.abc import Sequence
+from dataclasses import dataclass, replace
 from itertools import pairwise
 
 import networkx as nx
@@ -36,13 +37,21 @@ def _other(pos: TurnoutPosition | str) -> TurnoutPosition:
     return TurnoutPosition.reverse if str(pos) == "normal" else TurnoutPosition.normal
 
 
+@dataclass(frozen=True)
+class _Overlap:
+    sections: tuple[str, ...]
+    turnouts: tuple[RouteTurnout, ...]
+    release_s: float
+    end: str | None  # its end button, where the file names one
+
+
 class _Builder:
     def __init__(self, station: Station, rules: RuleSet) -> None:
         self.st = station
         self.rules = rules
         self.topo = station.topology
         self.errors: list[Diagnostic] = []
-        self._overlaps: dict[str, tuple[tuple[str, ...], tuple[RouteTurnout, ...], float]] = {}
+        self._overlaps: dict[str, list[_Overlap]] = {}
 
     # ---- routes between buttons ------------------------------------------------------------------------------
     def _train_end(self, node: str, d: Direction) -> tuple[str, str] | None:
@@ -353,7 +362,8 @@ class _Builder:
                 "receiving" if sig.kind is SignalKind.home else "transfer")
         else:
             category = "shunting"
-        ov_sections, ov_turnouts, ov_release = self._overlap(end_signal) if kind == "train" else ((), (), 0.0)
+        overlaps = self._overlap(end_signal) if kind == "train" else []
+        basic = overlaps[0] if overlaps else _Overlap((), (), 0.0, None)
         leads_into: str | None = None
         run_on: tuple[RunOn, ...] = ()
         if kind == "shunt" and end_signal is None and end not in st.buttons:
@@ -366,32 +376,41 @@ class _Builder:
             fouling=tuple(f for f in fouling if f.section not in path.sections),
             approach=self._approach(start), end_node=end_node, end_signal=end_signal, beyond=beyond,
             exit_link=exit_link, line_sections=line,
-            overlap_sections=ov_sections, overlap_turnouts=ov_turnouts, overlap_release_s=ov_release,
-            diamonds=diamonds, leads_into=leads_into, run_on=run_on,
+            overlap_sections=basic.sections, overlap_turnouts=basic.turnouts, overlap_release_s=basic.release_s,
+            overlap_end=basic.end, diamonds=diamonds, leads_into=leads_into, run_on=run_on,
         )
+        for alt in overlaps[1:]:  # alternative overlaps (变更延续进路): the same route, another overlap
+            routes[f"{rid}+{alt.end}"] = replace(
+                routes[rid], id=f"{rid}+{alt.end}", overlap_sections=alt.sections, overlap_turnouts=alt.turnouts,
+                overlap_release_s=alt.release_s, overlap_end=alt.end, overlap_alternative=True,
+                conflicts={}, conditional={}, head_on={}, added_enemies=set())
 
-    def _overlap(self, end_signal: str | None) -> tuple[tuple[str, ...], tuple[RouteTurnout, ...], float]:
-        """(sections, turnouts, release delay) of the overlap beyond ``end_signal``: the station file's own entry,
-        else the one its profile calls for (:mod:`.overlap`), else none."""
+    def _overlap(self, end_signal: str | None) -> list[_Overlap]:
+        """The overlaps beyond ``end_signal``, the basic one first: the station file's own entries (alternatives
+        after the first), else the one its profile calls for (:mod:`.overlap`), else none."""
         if end_signal is None:
-            return (), (), 0.0
+            return []
         if end_signal not in self._overlaps:
-            own = next((o for o in self.st.model.overlaps if o.end_signal == end_signal), None)
-            if own is not None:
-                self._overlaps[end_signal] = (
-                    tuple(own.sections), tuple(RouteTurnout(t.turnout, t.position, "route") for t in own.turnouts),
-                    self.rules.overlap_release_s if own.release_s is None else own.release_s)
+            own = [o for o in self.st.model.overlaps if o.end_signal == end_signal]
+            if own:
+                self._overlaps[end_signal] = [
+                    _Overlap(tuple(o.sections), self._overlap_turnouts([(t.turnout, t.position) for t in o.turnouts]),
+                             self.rules.overlap_release_s if o.release_s is None else o.release_s, o.end)
+                    for o in own]
             else:
                 found = profile_overlap(self.st, end_signal, self.rules.overlap_gradient_per_mille)
                 if found is None:
-                    self._overlaps[end_signal] = ((), (), 0.0)
+                    self._overlaps[end_signal] = []
                 else:
-                    lie = dict(found.turnouts)
-                    lie.update(self._partners([t for t, _ in found.turnouts], lie, set()))
-                    self._overlaps[end_signal] = (found.sections, tuple(RouteTurnout(t, p, "route")
-                                                                        for t, p in lie.items()),
-                                                  self.rules.overlap_release_s)
+                    self._overlaps[end_signal] = [_Overlap(found.sections, self._overlap_turnouts(found.turnouts),
+                                                           self.rules.overlap_release_s, None)]
         return self._overlaps[end_signal]
+
+    def _overlap_turnouts(self, turnouts: Sequence[tuple[str, TurnoutPosition]]) -> tuple[RouteTurnout, ...]:
+        """An overlap's turnouts with the crossover partners and driven turnouts they take along."""
+        lie = dict(turnouts)
+        lie.update(self._partners([t for t, _ in turnouts], lie, set()))
+        return tuple(RouteTurnout(t, p, "route") for t, p in lie.items())
 
     def _link_beyond(self, node: str, d: Direction) -> str | None:
         """The block link reached by going on from ``node`` in direction ``d`` without passing a turnout (or the

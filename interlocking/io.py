@@ -126,6 +126,7 @@ class Outputs:
     cab_codes: dict[str, str | None] = field(default_factory=dict)  # coded section -> low-frequency code
     line_out: dict[str, set[str]] = field(default_factory=dict)  # link -> pulses sent this cycle
     line_direction: dict[str, str] = field(default_factory=dict)  # automatic line -> 'outbound' when changed (改方)
+    axle_resets: set[str] = field(default_factory=set)  # axle-counter sections to reset (计轴复零), sent once
     changed_signals: set[str] = field(default_factory=set)
     changed_turnouts: set[str] = field(default_factory=set)
 

@@ -27,7 +27,8 @@ class Operator:
 
     # ---- route setting ----------------------------------------------------------------------------------------
     def set_route(self, kind: Kind, start: str, end: str, via: tuple[str, ...] = ()) -> Result:
-        """Select a route by its start, optional variant and end buttons (列车/调车进路)."""
+        """Select a route by its start, optional variant and end buttons (列车/调车进路); an overlap's end button
+        pressed after the end button chooses that alternative overlap (变更延续进路)."""
         st = self.il.station
         known = set(st.signals) | set(st.buttons)
         for b in (start, end, *via):
@@ -40,6 +41,8 @@ class Operator:
             other = "shunt" if kind == "train" else "route"
             return Result.refuse(f"signal {start} has no {_KIND_WORD[kind]} button; use '{other} {start} ...'")
         r = self.il.table.by_buttons(kind, start, end, via)
+        if r is None and via:  # the last button may be an overlap's end button
+            r = self.il.table.by_buttons(kind, start, via[-1], via[:-1], overlap=end)
         if r is None:
             options = sorted(x.id for x in self.il.table.routes.values() if x.kind == kind and x.start == start)
             return Result.refuse(f"no {_KIND_WORD[kind]} route from {start} to {end}"
@@ -462,6 +465,29 @@ class Operator:
             self.il.send(link, pulse)
         self.il.event("block", f"block line {link}: {action}, {before.value} -> {bl.state.value}")
         return Result.accept(f"block line {link}: {bl.state.value}")
+
+    def axle_reset(self, section: str) -> Result:
+        """计轴复零 (a sealed button, counted): set an axle-counter section's count to zero after its disturbance.
+        Refused on a track circuit, on a section that shows clear, and on one a route holds: the operator resets only
+        a line confirmed clear on site, never under a movement the interlocking has authorised."""
+        il = self.il
+        sec = il.station.sections.get(section)
+        if sec is None:
+            return Result.refuse(f"there is no section '{section}' at {il.station.id}")
+        if sec.type.value != "axle_counter":
+            return Result.refuse(f"section {section} is a track circuit, not counted by axle counters: nothing to "
+                                 "reset")
+        if il.clear(section):
+            return Result.refuse(f"the axle counter of {section} shows clear: nothing to reset")
+        holders = il.locks.section_holders(section)
+        if holders:
+            return Result.refuse(f"section {section} is locked in route {holders[0]}: a counter under a route is "
+                                 "never reset")
+        il.out.axle_resets.add(section)
+        il.axle_resets_used += 1
+        il.event("block", f"axle counter {section} reset (计轴复零, sealed button, counter {il.axle_resets_used})")
+        return Result.accept(f"axle counter {section} reset (sealed button 铅封, counter {il.axle_resets_used}); "
+                             "confirm the line clear on site before the next train")
 
     def doors(self, platform: str, action: str) -> Result:
         p = next((p for p in self.il.station.model.platforms if p.id == platform), None)

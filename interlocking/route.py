@@ -77,6 +77,8 @@ class Route:
     overlap_sections: tuple[str, ...] = ()
     overlap_turnouts: tuple[RouteTurnout, ...] = ()
     overlap_release_s: float = 0.0
+    overlap_end: str | None = None  # the overlap's end button, where the file names one
+    overlap_alternative: bool = False  # set only by pressing ``overlap_end`` (变更延续进路): not the basic overlap
     diamonds: tuple[str, ...] = ()  # diamond crossings the path runs over
     leads_into: str | None = None  # station track or spur a shunting route enters at sight at its end
     run_on: tuple[RunOn, ...] = ()  # one per way the turnouts beyond may lie
@@ -86,6 +88,13 @@ class Route:
     head_on: dict[str, str] = field(default_factory=dict)  # enemy route -> the track both lead onto
     added_enemies: set[str] = field(default_factory=set)  # enemies the station file adds (overrides.enemies)
     opposing: tuple[str, ...] = ()
+
+    @property
+    def buttons(self) -> tuple[str, ...]:
+        """The buttons that select the route, in the order pressed: start, variant buttons, end, and for an
+        alternative overlap its end button."""
+        return (self.start, *self.via, self.end) + ((self.overlap_end,) if self.overlap_alternative
+                                                    and self.overlap_end else ())
 
     @property
     def all_sections(self) -> tuple[str, ...]:
@@ -120,7 +129,8 @@ class Route:
             "approach": list(self.approach),
             "overlap": ({"sections": list(self.overlap_sections),
                          "turnouts": [{"id": t.id, "position": t.position.value} for t in self.overlap_turnouts],
-                         "release_s": self.overlap_release_s} if self.overlap_sections else None),
+                         "release_s": self.overlap_release_s, "end": self.overlap_end,
+                         "alternative": self.overlap_alternative} if self.overlap_sections else None),
             "diamonds": list(self.diamonds),
             "leads_into": self.leads_into,
             "run_on": [{"when": {t: p.value for t, p in ro.when}, "sections": list(ro.sections),
@@ -146,16 +156,22 @@ class InterlockingTable:
     throats: dict[str, tuple[str, ...]]  # throat name (its home signals) -> turnouts
     unselectable: list[str] = field(default_factory=list)  # paths with no distinguishing via button
 
-    _buttons: dict[tuple[str, str, str, tuple[str, ...]], Route] = field(default_factory=dict, init=False,
-                                                                         repr=False, compare=False)
+    _buttons: dict[tuple[str, str, str, tuple[str, ...], str | None], Route] = field(
+        default_factory=dict, init=False, repr=False, compare=False)
 
-    def by_buttons(self, kind: Kind, start: str, end: str, via: Iterable[str] = ()) -> Route | None:
-        key = (kind, start, end, tuple(via))
+    def by_buttons(self, kind: Kind, start: str, end: str, via: Iterable[str] = (),
+                   overlap: str | None = None) -> Route | None:
+        """The route the buttons select; ``overlap``: the overlap's end button pressed after the end button (none:
+        the basic overlap)."""
+        key = (kind, start, end, tuple(via), overlap)
         r = self._buttons.get(key)
         if r is None or self.routes.get(r.id) is not r:  # first use, or the routes were edited: index again
             self._buttons.clear()
             for x in self.routes.values():
-                self._buttons.setdefault((x.kind, x.start, x.end, x.via), x)
+                if not x.overlap_alternative:
+                    self._buttons.setdefault((x.kind, x.start, x.end, x.via, None), x)
+                if x.overlap_end is not None:
+                    self._buttons.setdefault((x.kind, x.start, x.end, x.via, x.overlap_end), x)
             r = self._buttons.get(key)
         return r
 

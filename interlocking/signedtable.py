@@ -193,6 +193,8 @@ class _Builder:
         if link is not None:
             if link.kind.value == "64d":
                 items.append("64D半自动闭塞")
+            elif link.kind.value == "station":
+                items.append("自动站间闭塞 " + " ".join(link.sections) + " 计轴空闲")
             else:
                 items.append("自动闭塞" + (f" {link.sections[0]}空闲" if link.sections else ""))
         if r.line_sections:
@@ -203,7 +205,8 @@ class _Builder:
         if r.diamonds:
             items.append("菱形交叉 " + " ".join(r.diamonds))
         if r.overlap_sections:
-            items.append("延续进路 " + " ".join([*r.overlap_sections, self.turnouts(r.overlap_turnouts)]).strip()
+            to = f"至 {r.overlap_end} " if r.overlap_end else ""
+            items.append(f"延续进路 {to}" + " ".join([*r.overlap_sections, self.turnouts(r.overlap_turnouts)]).strip()
                          + f" {r.overlap_release_s:g}s解锁")
         sig = self.st.signals.get(r.signal)
         release = sig.release_s if sig and sig.release_s is not None else self.rules.release_s[r.kind]
@@ -213,8 +216,9 @@ class _Builder:
 
     def row(self, n: int, r: Route) -> Row:
         cells = {
-            "no": str(n), "route": self.route_name(r), "mode": "变通" if r.via else "基本",
-            "buttons": " ".join(self.button(b, r.kind) for b in (r.start, *r.via, r.end)),
+            "no": str(n), "route": self.route_name(r),
+            "mode": "变更延续" if r.overlap_alternative else "变通" if r.via else "基本",
+            "buttons": " ".join(self.button(b, r.kind) for b in r.buttons),
             "signal": r.signal, "aspects": "/".join(r.aspects), "turnouts": self.turnouts(r.turnouts),
             "sections": self.sections(r), "enemies": self.enemies(r), "other": self.other(r),
         }

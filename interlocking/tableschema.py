@@ -31,8 +31,10 @@ _ROUTE: dict[str, Any] = {
             "properties": {"section": _STR, "turnout": _STR, "position": _POSITION}}},
         "approach": _STRS,
         "overlap": {"oneOf": [{"type": "null"}, {
-            "type": "object", "required": ["sections", "turnouts", "release_s"], "additionalProperties": False,
-            "properties": {"sections": _STRS, "release_s": {"type": "number"}, "turnouts": {"type": "array", "items": {
+            "type": "object", "required": ["sections", "turnouts", "release_s", "end", "alternative"],
+            "additionalProperties": False,
+            "properties": {"sections": _STRS, "release_s": {"type": "number"}, "end": _NULL_STR,
+                           "alternative": {"type": "boolean"}, "turnouts": {"type": "array", "items": {
                 "type": "object", "required": ["id", "position"], "additionalProperties": False,
                 "properties": {"id": _STR, "position": _POSITION}}}}}]},
         "diamonds": _STRS, "leads_into": _NULL_STR,

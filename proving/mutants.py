@@ -23,6 +23,7 @@ import liansuo.interlocking.derive as derive
 import liansuo.interlocking.lifecycle as lifecycle
 import liansuo.interlocking.locks as locks
 import liansuo.interlocking.operations as operations
+import liansuo.interlocking.stationblock as stationblock
 from liansuo.interlocking.io import RelayBoard, Result
 from liansuo.interlocking.route import Route
 from liansuo.interlocking.state import RouteStage, RouteState
@@ -222,6 +223,30 @@ def _block_over_occupied_line(s: ExitStack) -> None:
     _wrap(s, block64d.BlockLink, "operate", blind)
 
 
+def _station_block_ignores_neighbour(s: ExitStack) -> None:
+    def blocker(real: Any) -> Any:
+        def careless(self: Any, clear: Any) -> str:
+            if self.state in (stationblock.StationBlockState.inbound, stationblock.StationBlockState.arriving):
+                return ""
+            return real(self, clear)  # type: ignore[no-any-return]
+        return careless
+    _wrap(s, stationblock.StationBlockLink, "blocker", blocker)
+
+
+def _station_block_blind_to_counters(s: ExitStack) -> None:
+    def blocker(real: Any) -> Any:
+        def careless(self: Any, clear: Any) -> str:
+            return real(self, lambda section: True)  # type: ignore[no-any-return]
+        return careless
+
+    def step(real: Any) -> Any:
+        def careless(self: Any, departing: bool, clear: Any, *args: Any) -> None:
+            real(self, departing, lambda section: True, *args)
+        return careless
+    _wrap(s, stationblock.StationBlockLink, "blocker", blocker)
+    _wrap(s, stationblock.StationBlockLink, "step", step)
+
+
 def _guide_lock_ignores_doors(s: ExitStack) -> None:
     _patch(s, core.Core, "guide_only_doors", lambda self, signal: [])
 
@@ -322,6 +347,10 @@ MUTANTS: tuple[Mutant, ...] = (
     Mutant("no-64d-acceptance", "a 64D departure opens without the neighbour's acceptance", _no_64d_check),
     Mutant("64d-block-over-occupied-line", "a 64D block is given with the line's departure section occupied",
            _block_over_occupied_line),
+    Mutant("station-block-ignores-neighbour", "a departure onto a station-block line opens although the neighbour "
+           "has blocked the line for its own train", _station_block_ignores_neighbour),
+    Mutant("station-block-blind-to-counters", "the station block never reads the line's axle counters: a "
+           "departure opens with the line showing occupied", _station_block_blind_to_counters),
     Mutant("line-without-block-unchecked", "a departure onto a line with no block described ignores the line's "
            "track circuits", _line_without_block_unchecked),
     Mutant("against-running-direction", "a departure against a line's running direction opens without 改方",

@@ -1,11 +1,11 @@
 """Random operation of a station for the safety properties (``liansuo soak``, tests/test_oracle.py).
 
 A :class:`StepGenerator` draws one step at a time: a console command (routes, cancel, release, reopen, guide,
-turnouts, 64D, doors), a field or instructor action (occupancy, faults and repairs), a movement, or a wait. Every step
-is a line of the command language, so a run is a script: :func:`soak` records it, and a violation comes with the
-lines that lead to it. Movements are trains (``train``, ``drive``, ``stop``, ``auto``, ``reverse``) when the command
-language has them, and always sets of wheelsets (``axles``) walked along a route from its approach to beyond its end,
-a short train-like consist that shunts each section it stands on.
+turnouts, 64D, station block, doors), a field or instructor action (occupancy, faults and repairs, counter resets), a
+movement, or a wait. Every step is a line of the command language, so a run is a script: :func:`soak` records it,
+and a violation comes with the lines that lead to it. Movements are trains (``train``, ``drive``, ``stop``,
+``auto``, ``reverse``) when the command language has them, and always sets of wheelsets (``axles``) walked along a
+route from its approach to beyond its end, a short train-like consist that shunts each section it stands on.
 """
 
 from __future__ import annotations
@@ -48,6 +48,8 @@ class StepGenerator:
         self.turnouts = list(st.turnouts)
         self.throats = list(sim.table.throats)
         self.links64 = [lk.id for lk in st.model.links if lk.kind.value == "64d"]
+        self.station_lines = [lk.id for lk in st.model.links if lk.kind.value == "station"]
+        self.counted = [s.id for s in st.model.sections if s.type.value == "axle_counter"]
         self.platforms = [p.id for p in st.model.platforms if p.screen_doors]
         self.usu = [s.id for s in st.model.signals if s.usu]
         self.joints = list(st.joints)
@@ -59,6 +61,8 @@ class StepGenerator:
                     (self.fault, 4), (self.disturb, 6), (self.repair, 6), (self.walk, 22), (self.wait, 3)]
         if self.links64:
             families.append((self.block_line, 4))
+        if self.station_lines:
+            families.append((self.station_block, 3))
         if self.platforms:
             families.append((self.doors, 3))
         if self.trains:
@@ -78,7 +82,7 @@ class StepGenerator:
         free = [r for r in self.routes if r.signal not in il.by_signal]
         r = self.rng.choice(free or self.routes)
         word = "route" if r.kind == "train" else "shunt"
-        return [" ".join([word, r.start, *r.via, r.end])]
+        return [" ".join([word, *r.buttons])]
 
     def signal_op(self) -> list[str]:
         il = self.sim.interlocking
@@ -107,6 +111,12 @@ class StepGenerator:
             return [f"neighbour {link} {self.rng.choice(['request', 'depart', 'restore', 'accident'])}"]
         return [f"block-line {link} {self.rng.choice(['request', 'request', 'accept', 'cancel', 'restore'])}"]
 
+    def station_block(self) -> list[str]:
+        """The neighbour's departures on a station-block line, and the operator's counter reset (计轴复零)."""
+        if self.counted and self.rng.random() < 0.3:
+            return [f"axle-reset {self.rng.choice(self.counted)}"]
+        return [f"neighbour {self.rng.choice(self.station_lines)} {self.rng.choice(['block', 'cancel'])}"]
+
     def doors(self) -> list[str]:
         return [f"doors {self.rng.choice(self.platforms)} {self.rng.choice(['open', 'close', 'close'])}"]
 
@@ -121,7 +131,9 @@ class StepGenerator:
         rng = self.rng
         kind = rng.choice(["broken-rail", "poor-shunt", "insulation", "filament", "filament", "no-indication",
                            "obstruction", "high-resistance", "squeezed", "flasher", "capacitor", "low-ballast",
-                           "psd-stuck", "psd-no-close", "psd-no-open", "psd-bypass"])
+                           "psd-stuck", "psd-no-close", "psd-no-open", "psd-bypass", "axle-miscount"])
+        if kind == "axle-miscount":
+            return [f"fault axle-miscount {rng.choice(self.counted)}"] if self.counted else []
         if kind in ("broken-rail", "poor-shunt", "low-ballast"):
             return [f"fault {kind} {rng.choice(self.sections)}"]
         if kind == "capacitor":

@@ -38,7 +38,8 @@ USAGE = {
     "line-direction": "line-direction LINK out|in",
     "power-up-release": "power-up-release",
     "restart": "restart",
-    "neighbour": "neighbour LINK request|depart|restore|accident",
+    "neighbour": "neighbour LINK request|depart|restore|accident (64D) or block|cancel (station block)",
+    "axle-reset": "axle-reset SECTION",
     "doors": "doors PLATFORM open|close",
     "fault": "fault KIND TARGET [key=value ...]",
     "repair": "repair KIND TARGET",
@@ -201,6 +202,9 @@ def _neighbour(sim: World, args: list[str]) -> Result:
     if len(args) != 2:
         return Result.refuse(f"usage: {USAGE['neighbour']}")
     link, action = args
+    if link in sim.neighbours.station_lines:
+        why = sim.neighbours.station_action(link, action, sim.field.track_up)
+        return Result.refuse(why) if why else Result.accept(f"neighbour on {link}: {action}")
     if link not in sim.neighbours.by_link:
         return Result.refuse(f"there is no virtual neighbour on block line '{link}'")
     if action not in ("request", "depart", "restore", "accident"):
@@ -238,6 +242,7 @@ _HANDLERS: dict[str, Handler] = {
     "power-up-release": _power_up_release,
     "restart": _restart,
     "neighbour": _neighbour,
+    "axle-reset": _one("axle-reset", lambda s, a: s.interlocking.operator.axle_reset(a)),
     "doors": _doors,
     "fault": _fault,
     "repair": _repair,

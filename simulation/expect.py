@@ -76,7 +76,7 @@ def _expect(sim: World, args: list[str]) -> Result:
     if what == "block-line" and len(rest) == 2:
         line = sim.view.block_line(rest[0])
         if line is None:
-            return Result.refuse(f"there is no 64D block line '{rest[0]}'")
+            return Result.refuse(f"there is no 64D or station-block line '{rest[0]}'")
         return Result(line == rest[1], f"block line {rest[0]} is {line}")
     if what == "odometry" and len(rest) == 3 and rest[1] == "within":
         tr = sim.fleet.trains.get(rest[0])

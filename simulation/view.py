@@ -195,9 +195,13 @@ class InterlockingView:
         return self._il.out.line_direction.get(link) == "outbound"
 
     def block_line(self, link: str) -> str | None:
-        """The state of a 64D block line (idle, requested, ...), None if there is no such line."""
+        """The state of a 64D block line (idle, requested, ...) or of a station-block line (idle, outbound,
+        departed, inbound, arriving), None if there is no such line."""
         bl = self._il.core.links.get(link)
-        return None if bl is None else bl.state.value
+        if bl is not None:
+            return bl.state.value
+        sl = self._il.core.station_links.get(link)
+        return None if sl is None else sl.state.value
 
     def cab_code(self, section: str) -> str | None:
         """The low-frequency code a coded section carries, None when it carries none."""

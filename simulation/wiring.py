@@ -40,6 +40,8 @@ class Wiring:
             cmd.changed_signals.add(sig)
         cmd.doors = {k: (d.zckj, d.kmj, d.gmj) for k, d in out.doors.items()}
         cmd.cab_codes = out.cab_codes
+        cmd.axle_resets |= out.axle_resets
+        out.axle_resets.clear()
         return cmd
 
     def publish(self, board: RelayBoard, everything: bool = False) -> None:

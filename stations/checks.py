@@ -174,7 +174,7 @@ class _Checker:
         for i, t in enumerate(self.m.tracks):
             if t.section not in known:
                 self.err(("tracks", i, "section"), f"track '{t.id}' is in section '{t.section}', which is not declared",
-                         "add it under 'sections:' with its type (25hz or zpw2000a)")
+                         "add it under 'sections:' with its type (25hz, zpw2000a or axle_counter)")
             used[t.section] += 1
         for k, s in enumerate(self.m.sections):
             if used[s.id] == 0:
@@ -183,9 +183,9 @@ class _Checker:
             if s.type is CircuitType.zpw2000a and s.carrier is None:
                 self.err(("sections", k, "type"), f"ZPW-2000A section '{s.id}' has no carrier",
                          "add e.g. 'carrier: 2300-1' (down line 1700/2300, up line 2000/2600)")
-            if s.type is CircuitType.phase25hz and s.carrier is not None:
-                self.err(("sections", k, "carrier"), f"25 Hz section '{s.id}' cannot have a ZPW-2000A carrier",
-                         "remove 'carrier', or make the section 'type: zpw2000a'")
+            if s.type is not CircuitType.zpw2000a and s.carrier is not None:
+                self.err(("sections", k, "carrier"), f"section '{s.id}' ({s.type.value}) cannot have a ZPW-2000A "
+                         "carrier", "remove 'carrier', or make the section 'type: zpw2000a'")
             caps = s.capacitors
             if caps is not None and sum(x is not None for x in (caps.count, caps.positions, caps.rule)) != 1:
                 self.err(("sections", k, "capacitors"), f"section '{s.id}': give exactly one of count, positions, rule",
@@ -484,6 +484,10 @@ class _Checker:
                 self.err(("links", k, "bidirectional"), f"link {lk.id} is a {lk.kind.value} line; only automatic "
                          "block lines have a running direction to change (改方)",
                          "remove 'bidirectional', or make the line 'kind: automatic'")
+            if lk.kind is LinkKind.station and not lk.sections:
+                self.err(("links", k, "kind"), f"station-to-station block line {lk.id} names no sections",
+                         "list the line's sections under 'sections:' (those the axle counters prove clear), "
+                         "nearest the station first")
             roles = {roles_of[sec] for sec in lk.sections if sec in roles_of}
             if lk.kind is LinkKind.automatic and roles >= {SectionRole.approach, SectionRole.departure}:
                 self.err(("links", k, "sections"), f"link {lk.id} mixes approach and departure sections, so its "
@@ -506,6 +510,17 @@ class _Checker:
                 if t.turnout not in turnouts:
                     self.err(("overlaps", k, "turnouts", m), f"overlap turnout '{t.turnout}' is not declared",
                              "name a turnout listed under 'turnouts:'")
+            if o.end is not None and o.end not in signals and o.end not in {b.id for b in self.m.buttons}:
+                self.err(("overlaps", k, "end"), f"overlap end button '{o.end}' is not a signal or button",
+                         "name the signal or button the overlap ends at (its end button)")
+            alternatives = [x for x in self.m.overlaps if x.end_signal == o.end_signal]
+            if len(alternatives) > 1 and o.end is None:
+                self.err(("overlaps", k), f"signal {o.end_signal} has {len(alternatives)} overlaps; each alternative "
+                         "needs its 'end' (the overlap's end button the operator presses)",
+                         "add 'end: BUTTON' to every overlap of this signal; the first listed is the basic one")
+            if o.end is not None and sum(x.end == o.end for x in alternatives) > 1:
+                self.err(("overlaps", k, "end"), f"signal {o.end_signal} has two overlaps ending at '{o.end}'",
+                         "alternative overlaps end at different buttons")
         for key in ("protection", "remove_protection"):
             for m, p in enumerate(getattr(self.m.overrides, key)):
                 if p.turnout not in turnouts:

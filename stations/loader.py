@@ -1,4 +1,5 @@
-"""Load a station by bundled name or path: YAML -> strict schema -> cross-checks -> :class:`Station`.
+"""Load a station by bundled name or path: YAML -> strict schema -> double slips expanded into plain turnouts,
+tracks and diamonds (:mod:`.doubleslip`) -> cross-checks -> :class:`Station`.
 
 Nothing is half-loaded: either a complete, consistent :class:`Station` comes back or :class:`StationError` is raised
 with every problem found, each as ``FILE:LINE:COLUMN: message`` with a hint.
@@ -15,6 +16,7 @@ from pydantic import ValidationError
 from liansuo.rules import RuleSet
 
 from .checks import cross_check
+from .doubleslip import double_slip_errors, expand_double_slips
 from .library import resolve
 from .rules import design_warnings
 from .schema import StationFile
@@ -32,7 +34,8 @@ _HINTS = {
     "bool_type": "write true or false",
     "list_type": "write a list ('- item' lines)",
     "model_type": "write a mapping ('key: value' lines)",
-    "too_short": "the list needs at least one item",
+    "too_short": "add items: the message says how many the list needs",
+    "too_long": "remove items: the message says how many the list takes",
     "string_too_short": "write a non-empty text",
     "int_from_float": "write a whole number",
     "greater_than": "write a larger number",
@@ -84,6 +87,10 @@ def parse_source(src: Source, rules: RuleSet | None = None) -> Station:
         model = StationFile.model_validate_json(json.dumps(src.data, default=str), by_alias=True)
     except ValidationError as exc:
         raise StationError(_schema_diagnostics(src, exc)) from None
+    errors = double_slip_errors(model, src)
+    if errors:
+        raise StationError(errors)
+    model, src = expand_double_slips(model, src)  # into turnouts, tracks and a diamond: nothing later knows of them
     errors = cross_check(model, src)
     if errors:
         raise StationError(errors)

@@ -168,6 +168,7 @@ class Track(Strict):
 class CircuitType(StrEnum):
     phase25hz = "25hz"  # 97型 25 Hz 相敏轨道电路
     zpw2000a = "zpw2000a"  # ZPW-2000A 无绝缘移频
+    axle_counter = "axle_counter"  # 计轴: counting heads at its ends; clear when as many axles left as entered
 
 
 class SectionRole(StrEnum):
@@ -319,10 +320,15 @@ class Platform(Strict):
 class LinkKind(StrEnum):
     semi_auto_64d = "64d"  # 64D 半自动闭塞
     automatic = "automatic"  # 自动闭塞
+    station = "station"  # 自动站间闭塞: the whole line is one block section, proven clear by axle counters
 
 
 class Link(Strict):
     """A block link to a neighbour station (区间闭塞).
+
+    On a station-to-station block line (``kind: station``, 自动站间闭塞) the line between the two stations is one
+    block section, proven clear by its track-clear device (axle counters: sections of ``type: axle_counter``).
+    Setting a departure route blocks the line for our train; it restores by itself once the line is clear again.
 
     On an automatic block line the running direction follows from its sections: approach sections (``role:
     approach``) carry trains towards the station, departure sections away from it. ``bidirectional: true`` says the
@@ -348,12 +354,33 @@ class Diamond(Strict):
     at: Position | None = None  # where the tracks cross (optional; checked against both tracks when given)
 
 
+# the turnouts of one slip road: [low-end turnout, high-end turnout]
+SlipRoad = Annotated[list[Id], Field(min_length=2, max_length=2)]
+
+
+class DoubleSlip(Strict):
+    """A double slip (复式交分道岔): two tracks crossing at grade with both slip roads, so a movement from either
+    end of either track may leave by either track at the far end. Its four ends are four turnouts, numbered as two
+    crossover pairs (双动道岔), one pair per slip road: ``slips: [[21, 23], [25, 27]]`` joins 21 to 23 and 25 to 27
+    by the slip roads, while the straight roads 21-27 and 25-23 cross in the middle. The loader expands it into
+    those turnouts, four inner tracks and the diamond of the straight roads (stations/doubleslip.py)."""
+
+    id: Id
+    at: Position  # the centre, where the two straight roads cross
+    length: Metres  # from the low-end turnouts (at - length/2) to the high-end ones (at + length/2)
+    number: Annotated[int, Field(ge=6, le=62)]
+    machine: Machine
+    section: Id  # the track-circuit section it lies in, with the tracks at its four points
+    slips: Annotated[list[SlipRoad], Field(min_length=2, max_length=2)]
+    diverging_speed_kmh: Annotated[float, Field(gt=0, le=250)] | None = None  # over the slip roads
+
+
 class TurnoutPosition(StrEnum):
     normal = "normal"
     reverse = "reverse"
 
 
-_ROUTE_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_\-/]*(\([A-Za-z0-9_\-/,]+\))?(/D)?$")
+_ROUTE_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_\-/]*(\([A-Za-z0-9_\-/,]+\))?(\+[A-Za-z0-9_\-/]+)?(/D)?$")
 
 
 def _check_route_id(value: str) -> str:
@@ -363,7 +390,8 @@ def _check_route_id(value: str) -> str:
     return value
 
 
-# A route of the interlocking table, as 'liansuo table' names it: START-END, START-END(VIA), START-END/D.
+# A route of the interlocking table, as 'liansuo table' names it: START-END, START-END(VIA), START-END/D, and
+# START-END+OVERLAP_END for a route with an alternative overlap.
 RouteId = Annotated[str, AfterValidator(_check_route_id), WithJsonSchema({"type": "string",
                                                                            "pattern": _ROUTE_RE.pattern})]
 
@@ -400,9 +428,14 @@ class TurnoutAt(Strict):
 class Overlap(Strict):
     """An overlap (延续进路) beyond the end signal of receiving routes, where the file asks for one (e.g. a falling
     gradient over 6 per mille beyond the track): its sections and turnouts are locked with the route and released
-    ``release_s`` after the train occupies the receiving track (by default the rule set's ``overlap_release_s``)."""
+    ``release_s`` after the train occupies the receiving track (by default the rule set's ``overlap_release_s``).
+
+    Several entries for one end signal are alternative overlaps (变更延续进路): each names the button it ends at
+    (``end``, the overlap's end button, 延续进路终端按钮); the first is the basic overlap, set when the operator presses
+    no overlap button, the others are chosen by pressing their end button after the route's end button."""
 
     end_signal: Id
+    end: Id | None = None  # the overlap's end button (a signal or button); required for alternatives
     sections: list[Id] = Field(min_length=1)
     turnouts: list[TurnoutAt] = Field(default_factory=list)
     release_s: Annotated[float, Field(gt=0)] | None = None
@@ -438,6 +471,7 @@ class StationFile(Strict):
     buttons: list[StandaloneButton] = Field(default_factory=list)
     fouling_points: list[FoulingPoint] = Field(default_factory=list)
     diamonds: list[Diamond] = Field(default_factory=list)
+    double_slips: list[DoubleSlip] = Field(default_factory=list)
     profile: list[Grade] = Field(default_factory=list)
     markers: list[Marker] = Field(default_factory=list)
     platforms: list[Platform] = Field(default_factory=list)

@@ -18,6 +18,7 @@ def summarise(station: Station) -> dict[str, Any]:
         "track_length_m": round(sum(station.track_length(t) for t in station.tracks), 1),
         "turnouts": len(m.turnouts),
         "crossover_pairs": sorted(station.pairs),
+        "double_slips": [d.id for d in m.double_slips],  # their turnouts and pairs are counted above
         "sections": len(m.sections),
         "section_types": dict(Counter(s.type.value for s in m.sections)),
         "signals": len(m.signals),
@@ -37,6 +38,7 @@ def summary_text(station: Station) -> str:
         f"  tracks       {s['tracks']} ({s['track_length_m']:g} m of track)",
         f"  turnouts     {s['turnouts']}" + (f" (crossover pairs {', '.join(s['crossover_pairs'])})"
                                              if s["crossover_pairs"] else ""),
+        *([f"  double slips {', '.join(s['double_slips'])}"] if s["double_slips"] else []),
         f"  sections     {s['sections']} " + ", ".join(f"{k}: {v}" for k, v in s["section_types"].items()),
         f"  signals      {s['signals']} " + ", ".join(f"{k}: {v}" for k, v in s["signal_kinds"].items()),
         f"  platforms    {s['platforms']}",

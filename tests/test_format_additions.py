@@ -4,12 +4,16 @@ routes, and the coded-length rule at the speed trains really run. Each is used b
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
+import jsonschema
 import pytest
 from conftest import Driver
 
 from liansuo.interlocking.table import InterlockingTable, build_table
+from liansuo.interlocking.tableformat import as_json
+from liansuo.interlocking.tableschema import TABLE_SCHEMA
 from liansuo.proving.verify import verify_station
 from liansuo.simulation.sim import Simulation
 from liansuo.stations.loader import load, load_text
@@ -83,8 +87,45 @@ def test_the_interlocking_locks_the_derived_overlap_and_lets_the_through_movemen
     # receiving onto the siding drives the overlap's turnout 2 reverse; the onward departure over the same overlap
     # may be set at once and waits for it
     d2 = Driver(Simulation(str(EXAMPLES / "danxian.yaml")))
-    d2("block-line SL request", "run 3250ms", "route X X3", "route X3 S", "run 20s", "expect route X-X3 open",
+    d2("route X X3", "route X3 S", "run 20s", "expect route X-X3 open",
        "expect route X3-S open", "expect turnout 2 reverse locked")
+
+
+def test_alternative_overlaps_are_chosen_by_the_overlap_end_button() -> None:
+    t = build_table(load(str(EXAMPLES / "shuangxian.yaml")))
+    basic, alt = t.routes["X-XI"], t.routes["X-XI+XFK2"]
+    assert overlap(t, "X-XI") == (("10DG", "2-8DG"), {"10": "normal", "2": "normal", "8": "normal", "4": "normal",
+                                                      "6": "normal"})
+    assert overlap(t, "X-XI+XFK2") == (("10DG", "2-8DG", "4-6DG"), {"10": "normal", "2": "reverse", "4": "reverse"})
+    assert (basic.overlap_end, basic.overlap_alternative, alt.overlap_alternative) == ("XFCK", False, True)
+    assert alt.buttons == ("X", "XI", "XFK2") and basic.buttons == ("X", "XI")
+    assert "X-XI" in alt.conflicts  # one signal, one route at a time
+    data = json.loads(as_json(t))
+    jsonschema.validate(data, TABLE_SCHEMA)
+    row = next(r for g in data["groups"] for r in g["rows"] if r["id"] == "X-XI+XFK2")
+    assert row["mode"] == "变更延续" and row["buttons"].split()[-1] == "XFK2" and "延续进路 至 XFK2" in row["other"]
+    assert next(r for r in data["routes"] if r["id"] == "X-XI+XFK2")["overlap"]["alternative"] is True
+    d = Driver(Simulation(str(EXAMPLES / "shuangxian.yaml")))
+    d("line-direction SL-II out", "route X XI XFK2", "run 15s", "expect route X-XI+XFK2 open",
+      "expect turnout 2 reverse locked", "expect section 4-6DG locked")
+    d.refused("route XI XFCK", "conflicting route X-XI+XFK2")  # straight on needs 2 normal, the overlap reverse
+    d("route XI XFK2", "run 15s", "expect route XI-XFK2 locked")  # the through movement over the alternative
+    d2 = Driver(Simulation(str(EXAMPLES / "shuangxian.yaml")))
+    d2("route X XI", "run 15s", "expect route X-XI open", "expect turnout 2 normal locked", "expect section 4-6DG free")
+    d3 = Driver(Simulation(str(EXAMPLES / "shuangxian.yaml")))
+    d3("route X XI XFCK", "run 15s", "expect route X-XI open")  # the basic overlap's own button selects it too
+
+
+@pytest.mark.parametrize(("change", "what"), [
+    (("    end: XFK2\n", ""), "signal XI has 2 overlaps; each alternative needs its 'end'"),
+    (("    end: XFK2\n", "    end: XFCK\n"), "signal XI has two overlaps ending at 'XFCK'"),
+    (("    end: XFK2\n", "    end: NOPE\n"), "overlap end button 'NOPE' is not a signal or button"),
+])
+def test_alternative_overlaps_without_distinct_end_buttons_are_refused(change: tuple[str, str], what: str) -> None:
+    with pytest.raises(StationError) as info:
+        load_text(edit(SHUANGXIAN, change), "s.yaml")
+    d = next(d for d in info.value.diagnostics if what in d.message)
+    assert d.file == "s.yaml" and d.line > 1 and d.hint
 
 
 @pytest.mark.parametrize(("stretches", "what"), [

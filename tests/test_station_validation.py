@@ -221,7 +221,7 @@ BROKEN = [
     Broken("zpw2000a without carrier", edit(BASE, ("{id: 1DG, type: 25hz}", "{id: 1DG, type: zpw2000a}")),
            "ZPW-2000A section '1DG' has no carrier", "zpw2000a}", ("carrier: 2300-1",)),
     Broken("25hz with carrier", edit(BASE, ("{id: 1DG, type: 25hz}", "{id: 1DG, type: 25hz, carrier: 2300-1}")),
-           "25 Hz section '1DG' cannot have a ZPW-2000A carrier", "2300-1}", ("remove 'carrier'",)),
+           "section '1DG' (25hz) cannot have a ZPW-2000A carrier", "2300-1}", ("remove 'carrier'",)),
     Broken("capacitors on a 25hz section", edit(BASE, ("{id: 1DG, type: 25hz}",
                                                        "{id: 1DG, type: 25hz, capacitors: {count: 2}}")),
            "capacitors belong to ZPW-2000A sections", "{count: 2}"),

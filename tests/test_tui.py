@@ -248,7 +248,11 @@ async def test_every_fault_kind_is_offered_and_injects_from_the_panel() -> None:
         offered = [v for _, v in panel.query_one("#fault-kind")._options]  # type: ignore[attr-defined]
         assert set(offered) == set(KINDS)
         for kind in KINDS:
-            target = fault_targets(app.sim, kind)[0]
+            targets = fault_targets(app.sim, kind)
+            if kind == "axle-miscount":  # gaotie has track circuits only: no target is offered
+                assert targets == []
+                continue
+            target = targets[0]
             r = app.send(fault_line(app.sim, kind, target), "instructor")
             assert r.ok and (kind, target) in app.sim.field.faults, r.message
             assert app.send(f"repair {kind} {target}", "instructor").ok

@@ -17,7 +17,7 @@ _EXPECT = {
     "route": ("START", "END", "setting|locked|open|guide|closed|in_use|time_release|released"),
     "turnout": ("TURNOUT", "normal|reverse|none", "locked"),
     "section": ("SECTION", "free|locked|occupied"),
-    "block-line": ("LINK", "idle|requested|permitted|departed|asked|accepted|arriving|arrived"),
+    "block-line": ("LINK", "idle|requested|permitted|departed|asked|accepted|arriving|arrived|outbound|inbound"),
     "code": ("SECTION", "L|LU|U|UU|UUS|HU|HB|none"),
 }
 
@@ -95,6 +95,8 @@ def fault_targets(sim: Simulation, kind_name: str) -> list[str]:
     if t == "section":
         if kind_name == "capacitor":
             return [s for s, sec in st.sections.items() if sec.type.value == "zpw2000a"]
+        if kind_name == "axle-miscount":
+            return [s for s, sec in st.sections.items() if sec.type.value == "axle_counter"]
         return list(st.sections)
     if t == "turnout":
         return list(st.turnouts)

@@ -242,6 +242,8 @@ class _Builder:
             other = b if a.node == t.id else a
             if ry == y:
                 ry = self.line(self.nrows[other.node])
+            if ry == y:  # a reverse leg along the turnout's own line (a double slip's slip road): mind the normal leg
+                ry = self.line(self.rows[st.leg_track(t.id, "normal")])
             line = y - 1 if ry > y else y + 1
             legs_right = st.node_at(other.node) > st.node_at(t.id)
             text = t.id

@@ -89,13 +89,17 @@ class Tracer:
         self.role = {s: sec.role for s, sec in station.sections.items()}
         self.section_of = {t: tr.section for t, tr in station.tracks.items()}
         self.link_at = {lk.end: lk.id for lk in station.model.links}
-        self.overlaps: dict[str, tuple[tuple[str, ...], dict[str, str], float]] = {}
+        # end signal -> its overlaps (sections, turnout lie, release time); alternatives after the basic one
+        self.overlaps: dict[str, list[tuple[tuple[str, ...], dict[str, str], float]]] = {}
         if overlap_gradient_per_mille is not None:
             for end, (sections, lie) in steep_overlaps(station, overlap_gradient_per_mille).items():
-                self.overlaps[end] = (sections, lie, overlap_release_s)
-        for o in station.model.overlaps:  # the file's own overlap replaces one the profile calls for
-            self.overlaps[o.end_signal] = (tuple(o.sections), {t.turnout: t.position.value for t in o.turnouts},
-                                           o.release_s if o.release_s is not None else overlap_release_s)
+                self.overlaps[end] = [(sections, lie, overlap_release_s)]
+        own: dict[str, list[tuple[tuple[str, ...], dict[str, str], float]]] = {}
+        for o in station.model.overlaps:  # the file's own overlaps replace one the profile calls for
+            own.setdefault(o.end_signal, []).append((
+                tuple(o.sections), {t.turnout: t.position.value for t in o.turnouts},
+                o.release_s if o.release_s is not None else overlap_release_s))
+        self.overlaps.update(own)
         # the port of a track at a turnout: (track, turnout) -> leg
         self.leg_at: dict[tuple[str, str], str] = {}
         for tid, ports in station.track_ports.items():
@@ -145,7 +149,11 @@ class Tracer:
                     a.against.append(far)
                 track = st.leg_track(far, "point")
         if kind == "train" and a.end == "signal" and a.end_signal in self.overlaps:
-            a.overlap_sections, turnouts, a.overlap_release_s = self.overlaps[a.end_signal]
+            # of alternative overlaps, the one the turnouts beyond lie for (else the basic one, whose turnouts
+            # then lie against it)
+            options = self.overlaps[a.end_signal]
+            chosen = next((o for o in options if all(lies(t) == p for t, p in o[1].items())), options[0])
+            a.overlap_sections, turnouts, a.overlap_release_s = chosen
             a.overlap_turnouts = dict(turnouts)
         return a
 

@@ -118,6 +118,13 @@ class Ceiling:
             if view.line_permits(lk.id):
                 return Limit(self.semi_auto, f"64D line {lk.id} accepted by the neighbour")
             return Limit(self.a.stop, f"64D line {lk.id} has not been accepted by the neighbour station")
+        if lk.kind.value == "station":  # one block section to the neighbour, proven clear by its axle counters
+            if not view.line_permits(lk.id):
+                return Limit(self.a.stop, f"station-block line {lk.id} is blocked by the neighbour for its train")
+            occupied = [s for s in lk.sections if not view.clear(s)]
+            if occupied:
+                return Limit(self.a.stop, f"station-block line {lk.id}: {occupied[0]} shows occupied")
+            return Limit(self.semi_auto, f"station-block line {lk.id} clear and not blocked by the neighbour")
         clear = 0
         for s in lk.sections:
             if not view.clear(s):

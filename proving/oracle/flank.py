@@ -6,7 +6,9 @@ short of a signal that faces movements coming towards the path: that signal prot
 or from either end of a track that crosses the path at a diamond, is a flank turnout when it is met on its normal or
 reverse leg: it must lie the other way, away from the path, unless that way also leads straight into the path (as
 the other diagonal of a scissors crossover does), in which case it cannot protect and nothing is demanded of it.
-Met on its point, it cannot turn anything away either.
+Met on its point, it cannot turn anything away either, nor can the crossover partner of a path turnout the path needs
+the other way: it lies as its partner does (at a double slip, the partners of the turnouts of one straight road lead
+onto the other straight road, which crosses it at the diamond).
 
 A section just beyond a joint on a free leg, where the fouling point (警冲标) lies beyond that joint, is a fouling
 section: a vehicle standing there fouls the path, so it must be clear.
@@ -43,6 +45,7 @@ class Flank:
         self.st = station
         self.role = {t: station.sections[tr.section].role for t, tr in station.tracks.items()}
         self.fouled = {fp.track for fp in station.model.fouling_points if fp.track is not None}
+        self.partners = {t: [m for m in members if m != t] for members in station.pairs.values() for t in members}
         # turnout -> how far along its legs the fouling limit reaches: a tied fouling point's distance from the
         # turnout, plus the clearance a vehicle needs past it
         self.limit: dict[str, float] = {}
@@ -76,6 +79,8 @@ class Flank:
             if u in turnouts or leg == "point" or u in demands:
                 return
             protective = other(leg)
+            if any(turnouts.get(p, protective) != protective for p in self.partners.get(u, ())):
+                return  # it lies as its crossover partner in the path, never the protective way
             if self._leads_into(st.leg_track(u, protective), u, path, crossing):
                 return  # no position of u leads away from the path
             demands[u] = Demand(u, protective, why)

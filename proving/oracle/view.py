@@ -49,7 +49,8 @@ class FieldView(Protocol):
         """Every screen door of the platform at ``section`` is closed and locked, or its interlock is bypassed."""
 
     def line_permits(self, link: str) -> bool:
-        """A semi-automatic (64D) line: the neighbour has accepted our train and it has not left yet."""
+        """A semi-automatic (64D) line: the neighbour has accepted our train and it has not left yet. A
+        station-block line: the neighbour has not blocked it for a train of its own."""
 
     def line_outbound(self, link: str) -> bool:
         """An automatic line whose direction has been changed (改方) for our departures."""

@@ -148,7 +148,7 @@ class Probe:
 def route_line(r: Route) -> str:
     """The console command that selects ``r``."""
     word = "route" if r.kind == "train" else "shunt"
-    return " ".join([word, r.start, *r.via, r.end])
+    return " ".join([word, *r.buttons])
 
 
 def turnout_groups(station: Station, r: Route) -> list[tuple[str, str]]:

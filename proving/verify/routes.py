@@ -71,8 +71,9 @@ class RouteTest(RouteCheck):
 
     def liaison(self) -> None:
         """A departure's signal stays closed without the liaison: 64D without the neighbour's acceptance or with the
-        line's departure section occupied, automatic block with the first block section occupied; it opens once the
-        liaison is there."""
+        line's departure section occupied, station block with the line blocked by the neighbour or its counters
+        showing occupied, automatic block with the first block section occupied; it opens once the liaison is
+        there."""
         r = self.r
         il_links = self.ctx.station.model.links
         link = next((lk for lk in il_links if lk.id == r.exit_link), None)
@@ -98,6 +99,27 @@ class RouteTest(RouteCheck):
             p.do(f"vacate {line}")
             p.run(1.0)
             prepare(p, r)
+        elif link.kind.value == "station":
+            # the neighbour has blocked the line for a train of its own: our departure stays at stop until it
+            # cancels; then, with the line's counters showing occupied, it stays at stop until they show clear
+            p.do(f"neighbour {link.id} block")
+            p.run(SETTLE_S)
+            result = p.do(route_line(r))
+            p.run(SETTLE_S)
+            self.check(result.ok and p.closed(r.signal), "liaison",
+                       f"station-block departure with line {link.id} blocked by the neighbour: '{route_line(r)}' was "
+                       f"{'accepted' if result.ok else 'refused: ' + result.message} and {r.signal} shows "
+                       f"{p.aspect(r.signal)}", p)
+            p.do(f"neighbour {link.id} cancel")
+            ok = p.until(lambda: p.state(r) == "open", SETTLE_S)
+            self.check(ok, "liaison", f"signal {r.signal} did not open once the neighbour cancelled its block on "
+                       f"{link.id}: {p.blocker(r)}", p)
+            beyond = [s for s in link.sections if s not in r.sections]
+            if not beyond:
+                self.res.not_applicable.append("liaison (the line's sections are the route's own)")
+                return
+            p = Probe(self.ctx)
+            self.closed_while_occupied(p, beyond[0], "station block", "line section")
         elif against_running(self.ctx.station, link.id):
             # against the line's running direction: refused until the direction is changed (改方), which a line that
             # is not bidirectional never allows

@@ -144,7 +144,7 @@ def centre(sim: Lineside, tr: Train) -> None:
     if state == "released":
         route = sim.table.routes[rid]
         verb = "shunt" if route.kind == "shunt" else "route"
-        result = sim.command(" ".join([verb, route.start, *route.via, route.end]))
+        result = sim.command(" ".join([verb, *route.buttons]))
         if result.ok:
             ctl.requested = rid
             sim.log("train", f"train {tr.name}: centre asked for {rid}")
