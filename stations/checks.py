@@ -207,6 +207,13 @@ class _Checker:
         g = nx.Graph()
         for t in self.m.tracks:
             g.add_node(t.id)
+        counted = {sec.id for sec in self.m.sections if sec.type is CircuitType.axle_counter}
+        for k, j in enumerate(self.m.joints):
+            beside = sorted({self.m.tracks[i].section for i, _ in by_node.get(j.id, ())} & counted)
+            if beside and (j.at2 is not None or j.dead_zone_m):
+                self.err(("joints", k, "at2" if j.at2 is not None else "dead_zone_m"),
+                         f"joint '{j.id}' borders axle-counter section '{beside[0]}' but has a dead zone",
+                         "an axle counter counts at a point and has no dead zone: remove 'at2' / 'dead_zone_m'")
         for node, items in by_node.items():
             secs = {self.m.tracks[i].section for i, _ in items}
             if node in joints and len(items) == 2 and len(secs) == 1:

@@ -29,6 +29,23 @@ class Driver:
         return self.sim.aspect(signal)
 
 
+def edit(text: str, *pairs: tuple[str, str]) -> str:
+    """A station or script text with each ``old`` (which must occur exactly once) replaced by ``new``."""
+    for old, new in pairs:
+        assert text.count(old) == 1, f"{old!r} occurs {text.count(old)} times"
+        text = text.replace(old, new)
+    return text
+
+
+def position(text: str, needle: str) -> tuple[int, int]:
+    """1-based line and column of the (unique) ``needle`` in ``text``; a ``^`` in the needle marks the spot."""
+    offset = needle.index("^") if "^" in needle else 0
+    needle = needle.replace("^", "")
+    assert text.count(needle) == 1, f"{needle!r} occurs {text.count(needle)} times"
+    before = text[: text.index(needle) + offset]
+    return before.count("\n") + 1, len(before) - (before.rfind("\n") + 1) + 1
+
+
 @pytest.fixture
 def jiaopei() -> Driver:
     return Driver(Simulation("jiaopei"))

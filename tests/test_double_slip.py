@@ -8,7 +8,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from conftest import Driver
+from conftest import Driver, edit, position
 
 from liansuo.cli.main import main
 from liansuo.interlocking.signedtable import Row, signed_table
@@ -27,20 +27,6 @@ TEXT = EXAMPLE.read_text(encoding="utf-8")
 ENTRY = "  - {id: 21-27, at: 740, length: 34, number: 9, machine: ZD6, section: 21-27DG, slips: [[21, 23], [25, 27]]}"
 
 
-def edit(text: str, *pairs: tuple[str, str]) -> str:
-    for old, new in pairs:
-        assert text.count(old) == 1, f"{old!r} occurs {text.count(old)} times"
-        text = text.replace(old, new)
-    return text
-
-
-def position(text: str, needle: str) -> tuple[int, int]:
-    """1-based line and column of the (unique) ``needle`` in ``text``; a ``^`` in the needle marks the spot."""
-    offset = needle.index("^") if "^" in needle else 0
-    needle = needle.replace("^", "")
-    assert text.count(needle) == 1, f"{needle!r} occurs {text.count(needle)} times"
-    before = text[: text.index(needle) + offset]
-    return before.count("\n") + 1, len(before) - (before.rfind("\n") + 1) + 1
 
 
 @pytest.fixture(scope="module")

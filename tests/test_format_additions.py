@@ -9,7 +9,7 @@ from pathlib import Path
 
 import jsonschema
 import pytest
-from conftest import Driver
+from conftest import Driver, edit
 
 from liansuo.interlocking.table import InterlockingTable, build_table
 from liansuo.interlocking.tableformat import as_json
@@ -26,12 +26,6 @@ DANXIAN = (EXAMPLES / "danxian.yaml").read_text(encoding="utf-8")
 MINIMAL = (EXAMPLES / "minimal.yaml").read_text(encoding="utf-8")
 SHUANGXIAN = (EXAMPLES / "shuangxian.yaml").read_text(encoding="utf-8")
 
-
-def edit(text: str, *pairs: tuple[str, str]) -> str:
-    for old, new in pairs:
-        assert text.count(old) == 1, f"{old!r} occurs {text.count(old)} times"
-        text = text.replace(old, new)
-    return text
 
 
 def table(text: str) -> InterlockingTable:

@@ -112,6 +112,8 @@ def test_seeded_station_block_defects_are_caught(mutant: str) -> None:
     (("sections: [IIAG]}", "sections: []}"), "station-to-station block line SL names no sections"),
     (("{id: IIAG, type: axle_counter,", "{id: IIAG, type: axle_counter, carrier: 2300-1,"),
      "section 'IIAG' (axle_counter) cannot have a ZPW-2000A carrier"),
+    (("{id: J-S, at: 1800}", "{id: J-S, at: 1800, at2: 1803}"),
+     "joint 'J-S' borders axle-counter section 'IIAG' but has a dead zone"),
 ])
 def test_station_block_errors_name_file_and_line(edit: tuple[str, str], message: str) -> None:
     text = DANXIAN.read_text()

@@ -12,6 +12,7 @@ from typing import Any
 
 import pytest
 import yaml
+from conftest import edit, position
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from pydantic import BaseModel
@@ -31,24 +32,7 @@ BASE = MINIMAL.read_text(encoding="utf-8")
 JIAOPEI = (ROOT / "stations" / "library" / "jiaopei.yaml").read_text(encoding="utf-8")
 
 
-# ---- helpers ---------------------------------------------------------------------------------------------------
-def edit(text: str, *pairs: tuple[str, str]) -> str:
-    """Replace each ``old`` (which must occur exactly once) by ``new``."""
-    for old, new in pairs:
-        assert text.count(old) == 1, f"{old!r} occurs {text.count(old)} times in the base text"
-        text = text.replace(old, new)
-    return text
-
-
-def position(text: str, needle: str) -> tuple[int, int]:
-    """1-based line and column of the (unique) ``needle`` in ``text``; a ``^`` in the needle marks the spot."""
-    offset = needle.index("^") if "^" in needle else 0
-    needle = needle.replace("^", "")
-    assert text.count(needle) == 1, f"{needle!r} occurs {text.count(needle)} times"
-    before = text[: text.index(needle) + offset]
-    return before.count("\n") + 1, len(before) - (before.rfind("\n") + 1) + 1
-
-
+# ---- helpers (edit, position: conftest.py) ------------------------------------------------------------------
 def refuse(tmp_path: Path, text: str, name: str = "broken.yaml") -> tuple[StationError, Path]:
     path = tmp_path / name
     path.write_text(text, encoding="utf-8")
