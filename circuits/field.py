@@ -21,7 +21,7 @@ from .faults import Fault
 from .flasher import ElectronicFlasher, RelayFlasher
 from .lamps import SignalLamps
 from .machines import SwitchMachine
-from .railgeometry import Axle, RailGeometry
+from .railgeometry import Axle, geometry_of
 from .trackcircuits import SectionCircuit, build_circuit
 
 
@@ -52,7 +52,7 @@ class Field:
         self.station = station
         rules = rules or load_rules()
         self.flasher_lamp = rules.aspects.flasher_lamp
-        self.geometry = RailGeometry(station)
+        self.geometry = geometry_of(station)
         self.circuits: dict[str, SectionCircuit] = {
             s: build_circuit(station, s, self.geometry.section_length[s]) for s in station.sections}
         self.machines = {t.id: SwitchMachine(t.id, t.machine.value, equipment=rules.equipment)

@@ -27,6 +27,7 @@ import cmath
 import math
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, replace
+from functools import lru_cache
 
 # one ABCD (transmission) matrix: (A, B, C, D) with V1 = A V2 + B I2, I1 = C V2 + D I2
 _Abcd = tuple[complex, complex, complex, complex]
@@ -218,6 +219,11 @@ class Phase25HzCircuit:
     def evaluate(self, shunts: Sequence[tuple[float, float]] = (), faults: Phase25HzFaults | None = None
                  ) -> TrackCircuitState:
         """Relay-end state for wheelset shunts ``(distance_from_feed_end_m, resistance_ohm)`` and faults."""
+        if not shunts and (faults is None or faults == _HEALTHY):
+            return _adjustment(self.length_m, self.params)  # the same for every circuit of this length and tap
+        return self._evaluate(shunts, faults)
+
+    def _evaluate(self, shunts: Sequence[tuple[float, float]], faults: Phase25HzFaults | None) -> TrackCircuitState:
         p = self.params
         v = self.relay_phasor(shunts, faults)
         magnitude = abs(v)
@@ -286,9 +292,20 @@ class Phase25HzTrackRelay:
         return self.up
 
 
+_HEALTHY = Phase25HzFaults()
+
+
+@lru_cache(maxsize=4096)
+def _adjustment(length_m: float, params: Phase25HzParams) -> TrackCircuitState:
+    """The adjustment state (no train, no fault) of a circuit: pure in its length and parameters, so worked out once
+    for every simulation of a station (verify builds hundreds)."""
+    return Phase25HzCircuit(length_m, params)._evaluate((), None)
+
+
 TAP_STEP_V = 0.05  # feed transformer tap resolution of the model (secondary volts at nominal supply)
 
 
+@lru_cache(maxsize=4096)
 def adjusted_params(length_m: float, base: Phase25HzParams | None = None, target_V: float = 20.0
                     ) -> Phase25HzParams:
     """Pick the feed tap as a maintainer adjusts a section: the lowest tap giving at least ``target_V`` on the

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from typing import NamedTuple
+from weakref import WeakKeyDictionary
 
 from liansuo.stations.station import Station
 
@@ -79,3 +80,15 @@ class RailGeometry:
         sec = self.station.tracks[axle.track].section
         d = min(max(axle.x - self.section_low[sec], 0.0), self.section_length[sec])
         return Shunt(sec, d, axle.ohm)
+
+
+_GEOMETRY: WeakKeyDictionary[Station, RailGeometry] = WeakKeyDictionary()
+
+
+def geometry_of(station: Station) -> RailGeometry:
+    """The station's rail geometry, worked out once per station: it never changes, and every simulation of the
+    station (verify builds thousands) reads the same."""
+    g = _GEOMETRY.get(station)
+    if g is None:
+        g = _GEOMETRY[station] = RailGeometry(station)
+    return g

@@ -8,6 +8,7 @@ import json
 import sys
 from collections.abc import Callable
 from pathlib import Path
+from typing import TextIO
 
 from liansuo.stations.cli import print_errors
 from liansuo.stations.loader import load
@@ -20,7 +21,7 @@ def cmd_table(args: argparse.Namespace) -> int:
     # the derivation (networkx) and the xlsx writer (openpyxl) load only when a table is asked for
     from .signedtable import signed_table
     from .table import build_table
-    from .tableformat import as_csv, as_json, as_text
+    from .tableformat import as_text, write_csv, write_json
     from .tableschema import TABLE_SCHEMA
 
     if args.schema:
@@ -40,13 +41,29 @@ def cmd_table(args: argparse.Namespace) -> int:
         from .tablexlsx import write_xlsx
 
         return _write(Path(args.output), lambda tmp: write_xlsx(signed_table(table), tmp))
-    text = {"text": as_text, "csv": as_csv, "json": as_json}[args.format](table)
-    if args.format != "csv":
-        text += "\n"
+    if args.format == "text":
+        text = as_text(table) + "\n"
+        if args.output is None:
+            print(text, end="")
+            return 0
+        return _write(Path(args.output), lambda tmp: tmp.write_text(text, encoding="utf-8"))
+
+    def write(out: TextIO) -> None:  # CSV and JSON go out row by row (a hub's would not fit in memory at once)
+        if args.format == "csv":
+            write_csv(table, out)
+        else:
+            write_json(table, out)
+            out.write("\n")
+
     if args.output is None:
-        print(text, end="")
+        write(sys.stdout)
         return 0
-    return _write(Path(args.output), lambda tmp: tmp.write_text(text, encoding="utf-8"))
+    return _write(Path(args.output), lambda tmp: _stream(tmp, write))
+
+
+def _stream(path: Path, write: Callable[[TextIO], None]) -> None:
+    with path.open("w", encoding="utf-8", newline="") as out:
+        write(out)
 
 
 def _write(path: Path, write: Callable[[Path], object]) -> int:

@@ -138,7 +138,8 @@ def _bulk(routes: dict[str, Route], en: _Enmity, simple: list[int]) -> None:
             if new:
                 c.update(dict.fromkeys(new, why))
 
-    for s, holders in en.by_section.items():
+    # in a fixed order (by element name): the first reason found is the one the table prints, the same on every run
+    for s, holders in sorted(en.by_section.items()):
         ids = holders & keep
         if not ids:
             continue
@@ -154,12 +155,12 @@ def _bulk(routes: dict[str, Route], en: _Enmity, simple: list[int]) -> None:
         if fouled:
             add(ids, {v[j].route.id for j in fouled}, f"fouling section {s}")
             add(fouled, {v[j].route.id for j in ids}, f"fouling section {s}")
-    for (t, pos), holders in en.by_turnout.items():
+    for (t, pos), holders in sorted(en.by_turnout.items(), key=lambda kv: (kv[0][0], kv[0][1].value)):
         ids = holders & keep
         opposite = en.by_turnout.get((t, _flip(pos)), set()) & keep
         if ids and opposite:
             add(ids, {v[j].route.id for j in opposite}, f"turnout {t} {pos.value}/{_flip(pos).value}")
-    for d, holders in en.by_diamond.items():
+    for d, holders in sorted(en.by_diamond.items()):
         ids = holders & keep
         add(ids, {v[j].route.id for j in ids}, f"diamond {d}")
     for track, leading in en.onto.items():

@@ -2,6 +2,10 @@
 
 Text and CSV print the cells of :mod:`.signedtable`, so they agree with each other and with the xlsx export
 (:mod:`.tablexlsx`); JSON is the table's data (``InterlockingTable.as_dict``) with the signed groups added.
+
+CSV and JSON are written row by row (:func:`write_csv`, :func:`write_json`): a hub's table lists hundreds of
+thousands of conflicting pairs, and holding its whole JSON document (and then its text) at once took most of a
+gigabyte. The JSON written is the same, byte for byte, as ``json.dumps(document, indent=2)``.
 """
 
 from __future__ import annotations
@@ -9,6 +13,8 @@ from __future__ import annotations
 import csv
 import io
 import json
+from collections.abc import Iterator
+from typing import TextIO
 
 from .signedtable import COLUMNS, SignedTable, cell_width, signed_table
 from .table import InterlockingTable
@@ -77,17 +83,55 @@ def as_text(table: InterlockingTable) -> str:
 
 def as_csv(table: InterlockingTable) -> str:
     buf = io.StringIO()
-    w = csv.writer(buf)
+    write_csv(table, buf)
+    return buf.getvalue()
+
+
+def write_csv(table: InterlockingTable, out: TextIO) -> None:
+    w = csv.writer(out)
     w.writerow(["id", "group", *(c.key for c in COLUMNS)])
     for g in signed_table(table).groups:
         for row in g.rows:
             w.writerow([row.route, g.name, *(row.cells[c.key] for c in COLUMNS)])
-    return buf.getvalue()
 
 
 def as_json(table: InterlockingTable) -> str:
-    data = table.as_dict()
+    buf = io.StringIO()
+    write_json(table, buf)
+    return buf.getvalue()
+
+
+def write_json(table: InterlockingTable, out: TextIO) -> None:
+    """The table's document (no newline after it), one route and one group at a time."""
     signed = signed_table(table)
-    data["station_file"] = {"name": signed.file, "sha256": signed.sha256}
-    data["groups"] = signed.as_dict()
-    return json.dumps(data, ensure_ascii=False, indent=2)
+    out.write("{\n")
+    _member(out, "station", table.station.id)
+    out.write(',\n  "routes": ')
+    _array(out, (r.as_dict() for r in table.routes.values()), bool(table.routes))
+    out.write(",\n")
+    _member(out, "throats", {k: list(v) for k, v in table.throats.items()})
+    out.write(",\n")
+    _member(out, "station_file", {"name": signed.file, "sha256": signed.sha256})
+    out.write(',\n  "groups": ')
+    _array(out, ({"name": g.name, "direction": g.direction, "category": g.category, "throat": g.throat,
+                  "rows": [{"id": r.route, **r.cells} for r in g.rows]} for g in signed.groups), bool(signed.groups))
+    out.write("\n}")
+
+
+def _dumps(value: object, depth: int) -> str:
+    """``value`` as json.dumps(indent=2) writes it ``depth`` levels down."""
+    return json.dumps(value, ensure_ascii=False, indent=2).replace("\n", "\n" + "  " * depth)
+
+
+def _member(out: TextIO, key: str, value: object) -> None:
+    out.write(f"  {json.dumps(key, ensure_ascii=False)}: {_dumps(value, 1)}")
+
+
+def _array(out: TextIO, items: Iterator[object], any_items: bool) -> None:
+    if not any_items:
+        out.write("[]")
+        return
+    out.write("[")
+    for i, item in enumerate(items):
+        out.write(("," if i else "") + "\n    " + _dumps(item, 2))
+    out.write("\n  ]")

@@ -1,5 +1,8 @@
-"""``liansuo soak STATION --steps N --seed S [--format text|json] [--out DIR]``: long random runs under the safety
-oracle, with a reproducer script for each violation.
+"""``liansuo soak STATION --steps N --seed S [--runs K] [--workers W] [--scheduler ADDRESS] [--format text|json]
+[--out DIR]``: long random runs under the safety oracle, with a reproducer script for each violation.
+
+``--runs K`` makes K independent runs, seeds S .. S+K-1, each of N steps; ``--workers W`` fans them out on Dask
+(:mod:`.spread`; K defaults to W), and the runs are reported in seed order whatever finished first.
 
 A reproducer is a YAML test script with ``safety: true``: ``liansuo test FILE`` (or pytest) replays the commands and
 fails at the step where the violation happens. It is cut down from the run: first the shortest tail of the commands
@@ -19,7 +22,9 @@ from pathlib import Path
 from liansuo.simulation.sim import Simulation
 
 from .oracle import Violation, Watch
+from .progress import progress
 from .soak import SoakRun, soak
+from .spread import fan_out
 
 Add = Callable[..., argparse.ArgumentParser]
 MAX_REPRODUCERS = 5
@@ -113,37 +118,86 @@ def report(run: SoakRun, *, shrink_budget_s: float = SHRINK_BUDGET_S) -> dict[st
             "elapsed_s": round(run.elapsed_s, 2), "hazards": dict(sorted(run.hazards.items())), "violations": out}
 
 
+def run_seed(shared: tuple[str, int], seed: int) -> dict[str, object]:
+    """One whole run and its report (reproducers included): what a worker does for one seed."""
+    station, steps = shared
+    return report(soak(station, steps, seed))
+
+
+def soak_runs(station: str, steps: int, seeds: list[int], *, workers: int = 0, scheduler: str | None = None,
+              show_progress: bool | None = False) -> list[dict[str, object]]:
+    """The report of a run for each seed, in seed order: here one after the other, or on Dask."""
+    from liansuo.stations.loader import load
+
+    load(station)  # a station that does not load is reported here, once, not by every worker
+    with progress(f"soak {Path(station).stem}", len(seeds) * steps, show=show_progress) as advance:
+        if not workers:
+            out = []
+            for seed in seeds:
+                out.append(run_seed((station, steps), seed))
+                advance(steps)
+            return out
+        return fan_out((station, steps), seeds, run_seed, workers=workers, scheduler=scheduler, advance=advance,
+                       size=lambda seed: steps)
+
+
 def cmd_soak(args: argparse.Namespace) -> int:
     from liansuo.stations.source import StationError
 
+    workers = args.workers or (1 if args.scheduler else 0)
+    runs = args.runs or max(1, workers)
+    seeds = [args.seed + k for k in range(runs)]
+    t0 = time.perf_counter()
     try:
-        run = soak(args.station, args.steps, args.seed)
+        reps = soak_runs(args.station, args.steps, seeds, workers=workers, scheduler=args.scheduler,
+                         show_progress=None)
     except StationError as exc:
         for d in exc.diagnostics:
             print(d, file=sys.stderr)
         return 1
-    rep = report(run)
-    violations: list[dict[str, object]] = rep["violations"]  # type: ignore[assignment]
-    if args.out:
-        out = Path(args.out)
-        out.mkdir(parents=True, exist_ok=True)
-        for k, v in enumerate(x for x in violations if x["reproducer"]):
-            (out / f"soak-{run.station}-{run.seed}-{k + 1}.yaml").write_text(str(v["reproducer"]), encoding="utf-8")
+    elapsed = time.perf_counter() - t0
+    found = 0
+    for rep in reps:
+        violations: list[dict[str, object]] = rep["violations"]  # type: ignore[assignment]
+        found += len(violations)
+        if args.out:
+            out = Path(args.out)
+            out.mkdir(parents=True, exist_ok=True)
+            for k, v in enumerate(x for x in violations if x["reproducer"]):
+                (out / f"soak-{rep['station']}-{rep['seed']}-{k + 1}.yaml").write_text(str(v["reproducer"]),
+                                                                                    encoding="utf-8")
     if args.format == "json":
-        print(json.dumps(rep, ensure_ascii=False, indent=2))
+        if len(reps) == 1 and not workers:
+            print(json.dumps(reps[0], ensure_ascii=False, indent=2))
+        else:
+            steps = sum(int(str(r["steps"])) for r in reps)
+            print(json.dumps({"station": reps[0]["station"], "runs": reps, "workers": workers, "steps": steps,
+                              "elapsed_s": round(elapsed, 2), "steps_per_s": round(steps / elapsed, 1),
+                              "violations": found}, ensure_ascii=False, indent=2))
     else:
-        print(f"liansuo soak {run.station}: {run.steps} steps (seed {run.seed}), {run.cycles} cycles, "
-              f"{run.simulated_s:.0f} s simulated, {len(run.lines)} commands ({run.refused} refused), "
-              f"{run.elapsed_s:.1f} s")
-        if run.hazards:
-            print("hazards (dangers the interlocking cannot see by design, not violations): "
-                  + ", ".join(f"{k} {n}" for k, n in sorted(run.hazards.items())))
-        for v in violations:
-            print(f"VIOLATION t = {v['t']:g} s {v['property']}: {v['text']}")
-            if v["reproducer"]:
-                print("  reproducer:\n" + "\n".join(f"    {line}" for line in str(v["reproducer"]).splitlines()))
-        print(f"{len(violations)} violations")
-    return 1 if violations else 0
+        for rep in reps:
+            print(run_text(rep))
+        if len(reps) > 1:
+            print(f"{len(reps)} runs (seeds {seeds[0]}..{seeds[-1]}) on {workers or 1} worker(s) in {elapsed:.1f} s: "
+                  f"{found} violations")
+    return 1 if found else 0
+
+
+def run_text(rep: dict[str, object]) -> str:
+    violations: list[dict[str, object]] = rep["violations"]  # type: ignore[assignment]
+    hazards: dict[str, int] = rep["hazards"]  # type: ignore[assignment]
+    lines = [f"liansuo soak {rep['station']}: {rep['steps']} steps (seed {rep['seed']}), {rep['cycles']} cycles, "
+             f"{float(str(rep['simulated_s'])):.0f} s simulated, {rep['commands']} commands ({rep['refused']} "
+             f"refused), {float(str(rep['elapsed_s'])):.1f} s"]
+    if hazards:
+        lines.append("hazards (dangers the interlocking cannot see by design, not violations): "
+                     + ", ".join(f"{k} {n}" for k, n in sorted(hazards.items())))
+    for v in violations:
+        lines.append(f"VIOLATION t = {v['t']:g} s {v['property']}: {v['text']}")
+        if v["reproducer"]:
+            lines.append("  reproducer:\n" + "\n".join(f"    {line}" for line in str(v["reproducer"]).splitlines()))
+    lines.append(f"{len(violations)} violations")
+    return "\n".join(lines)
 
 
 def register(add: Add) -> None:
@@ -153,4 +207,10 @@ def register(add: Add) -> None:
     sp.add_argument("--seed", type=int, default=1)
     sp.add_argument("--format", choices=("text", "json"), default="text")
     sp.add_argument("--out", metavar="DIR", help="also write each reproducer to DIR/soak-STATION-SEED-N.yaml")
+    sp.add_argument("--runs", type=int, default=0, metavar="K",
+                    help="independent runs, seeds SEED .. SEED+K-1 (default: one per worker)")
+    sp.add_argument("--workers", type=int, default=0, metavar="N",
+                    help="fan the runs out on Dask over N local worker processes (default: run here)")
+    sp.add_argument("--scheduler", metavar="ADDRESS",
+                    help="run on the Dask cluster whose scheduler is at ADDRESS (tcp://host:8786); docs/cluster.md")
     sp.set_defaults(handler=cmd_soak)

@@ -1,4 +1,5 @@
-"""``liansuo stations``, ``liansuo check STATION [--format text|json]`` and ``liansuo schema``: the station files."""
+"""``liansuo stations``, ``liansuo check STATION [--format text|json]``, ``liansuo schema`` and ``liansuo generate hub
+--turnouts N --tracks M [-o FILE]``: the station files."""
 
 from __future__ import annotations
 
@@ -55,9 +56,47 @@ def cmd_schema(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_generate(args: argparse.Namespace) -> int:
+    """A generated hub station file (the benchmark's), on stdout or in ``-o FILE``."""
+    from pathlib import Path
+
+    from .hubgen import generate_hub
+    from .loader import load_text
+
+    try:
+        text = generate_hub(args.turnouts, args.tracks)
+    except ValueError as exc:
+        print(f"liansuo generate hub: {exc}", file=sys.stderr)
+        return 2
+    name = args.output or f"<hub{args.turnouts}>"
+    load_text(text, name)  # what is written always loads: the generator's own check
+    if args.output:
+        Path(args.output).write_text(text, encoding="utf-8")
+        print(f"wrote {args.output}: a hub with {args.turnouts} turnouts and {args.tracks} station tracks "
+              f"(liansuo check {args.output})", file=sys.stderr)
+    else:
+        sys.stdout.write(text)
+    return 0
+
+
 def register(add: Add) -> None:
     add("stations", cmd_stations, "list the bundled stations")
     sp = add("check", cmd_check, "validate a station file and summarise it")
     sp.add_argument("station", help="bundled station name or path to a station YAML file")
     sp.add_argument("--format", choices=("text", "json"), default="text")
     add("schema", cmd_schema, "print the JSON Schema of the station format")
+    sp = add("generate", cmd_generate, "write a generated station file (a hub of any size, for stress tests)")
+    sp.add_argument("kind", choices=("hub",), help="what to generate: 'hub', a double-ended yard of parallel tracks")
+    sp.add_argument("--turnouts", type=_positive, required=True, metavar="N", help="turnouts in the hub")
+    sp.add_argument("--tracks", type=_positive, required=True, metavar="M", help="station tracks in the hub")
+    sp.add_argument("-o", "--output", metavar="FILE", help="write the station file here (default: stdout)")
+
+
+def _positive(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"{value} is not a positive number")
+    return value

@@ -113,9 +113,16 @@ class Station:
         return self.turnouts[node].at
 
     def track_span(self, track: str) -> tuple[float, float]:
-        a, b = self.track_ports[track]
-        xa, xb = self.node_at(a.node), self.node_at(b.node)
-        return (xa, xb) if xa <= xb else (xb, xa)
+        return self._spans[track]
+
+    @cached_property
+    def _spans(self) -> dict[str, tuple[float, float]]:
+        """(low, high) position of every track, asked for on every cycle and by every simulation of the station."""
+        out = {}
+        for tid, (a, b) in self.track_ports.items():
+            xa, xb = self.node_at(a.node), self.node_at(b.node)
+            out[tid] = (xa, xb) if xa <= xb else (xb, xa)
+        return out
 
     def track_length(self, track: str) -> float:
         return self._track_lengths[track]
@@ -152,10 +159,17 @@ class Station:
 
     def joint_tracks(self, joint: str) -> tuple[str, str]:
         """(track on the low side, track on the high side) of a joint."""
-        tracks = [tid for _, tid in self.node_tracks[joint]]
-        low = [t for t in tracks if self.track_high_port(t).node == joint]
-        high = [t for t in tracks if self.track_low_port(t).node == joint]
-        return low[0], high[0]
+        found = self._joint_tracks.get(joint)
+        if found is None:
+            tracks = [tid for _, tid in self.node_tracks[joint]]
+            low = [t for t in tracks if self.track_high_port(t).node == joint]
+            high = [t for t in tracks if self.track_low_port(t).node == joint]
+            found = self._joint_tracks[joint] = (low[0], high[0])
+        return found
+
+    @cached_property
+    def _joint_tracks(self) -> dict[str, tuple[str, str]]:
+        return {}  # filled as asked (a joint's two tracks never change)
 
     def joint_sections(self, joint: str) -> tuple[str, str]:
         lo, hi = self.joint_tracks(joint)

@@ -9,8 +9,8 @@ import sys
 
 from liansuo.cli.main import build_parser
 
-SUBCOMMANDS = {"stations", "check", "schema", "table", "zpw", "run", "test", "verify", "soak", "mutate", "bench",
-               "tui", "replay"}
+SUBCOMMANDS = {"stations", "check", "schema", "generate", "table", "zpw", "run", "test", "verify", "soak", "mutate",
+               "bench", "tui", "replay"}
 
 
 def test_every_subcommand_is_registered() -> None:

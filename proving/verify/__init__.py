@@ -12,20 +12,19 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from liansuo.interlocking.table import InterlockingTable, build_table
+from liansuo.interlocking.table import InterlockingTable
 from liansuo.rules import RuleSet, load_rules
 from liansuo.stations.loader import load
 from liansuo.stations.station import Station
 
 from ..oracle.pairs import PaperOracle
+from ..progress import progress
 from .against import approach_extent, pair_conflicts, route_demands
 from .data import check_station
-from .pairs import PairTest
-from .probe import Context, Failure, FirstFailure
-from .release import throat_checks
+from .plan import UnitResult, merge, plan
+from .probe import Failure, FirstFailure
 from .routecheck import RouteResult
-from .routes import RouteTest
-from .station import power_up, red_lamp_transfer
+from .units import Bench, frozen, run_here, spread_units
 
 
 @dataclass
@@ -70,45 +69,53 @@ class VerifyReport:
 
 def verify_station(station: str | Path | Station, *, routes: list[str] | None = None, pairs: bool = True,
                    strict: bool = False, rules: RuleSet | None = None, cycle_s: float = 0.25,
-                   stop_at_first: bool = False) -> VerifyReport:
+                   stop_at_first: bool = False, workers: int = 0, scheduler: str | None = None,
+                   show_progress: bool | None = False) -> VerifyReport:
     """Run the whole interlocking test; ``routes`` limits route and pair checks to those routes. The table is held
-    against the oracle first (quick), then every route and pair is tried on the running simulation.
-    ``stop_at_first``: stop at the first failure (the mutation run only needs to know that one was found)."""
+    against the oracle first (quick), then every unit of the dynamic test (:mod:`.plan`) runs: here, one after the
+    other (``workers`` 0), or fanned out on Dask over ``workers`` local processes or the cluster at ``scheduler``
+    (:mod:`proving.spread`). The report is the same either way.
+    ``stop_at_first``: stop at the first failure (the mutation run only needs to know that one was found; here only).
+    ``show_progress``: a bar on stderr (None: when it is a terminal)."""
     t0 = time.perf_counter()
     rules = rules or load_rules()
     st = station if isinstance(station, Station) else load(station, rules=rules)
-    table = build_table(st, rules)
-    ctx = Context(st, table, rules, cycle_s, stop_at_first=stop_at_first)
+    bench = Bench.build(st, rules, cycle_s)
+    table = bench.table
+    ctx = bench.context(stop_at_first)
     focus = set(routes) if routes else None
-    results: list[RouteResult] = []
-    pair_test = PairTest(ctx)
-    try:
-        if focus:
-            for rid in sorted(focus - set(table.routes)):
-                ctx.record(False, "route", rid, f"there is no route {rid}; see 'liansuo table {st.id}'")
-        oracle = PaperOracle(st, ctx.rules)
-        for r in table.routes.values():
-            if not focus or r.id in focus:
-                route_demands(ctx, oracle, r)
-        if pairs:
-            pair_conflicts(ctx, oracle, focus)
-        if not focus:
-            approach_extent(ctx)
-        for r in table.routes.values():
-            if not focus or r.id in focus:
-                results.append(RouteTest(ctx, r).run())
-        if pairs:
-            pair_test.run(table.routes.values(), focus)
-        if not focus:
-            throat_checks(ctx)
-            power_up(ctx)
-            red_lamp_transfer(ctx)
-        check_station(ctx, focus)
-    except FirstFailure:
-        pass
-    return VerifyReport(st.id, st.display_name(), len(table.routes), len(results), pair_test.tested,
-                        pair_test.conflicting, pair_test.compatible, ctx.checks, ctx.failures, ctx.warnings,
-                        results, table, time.perf_counter() - t0, strict)
+    work = plan(table, focus, pairs=pairs)
+    results: list[UnitResult] = []
+    with frozen():
+        try:
+            if focus:
+                for rid in sorted(focus - set(table.routes)):
+                    ctx.record(False, "route", rid, f"there is no route {rid}; see 'liansuo table {st.id}'")
+            oracle = PaperOracle(st, ctx.rules)
+            for r in table.routes.values():
+                if not focus or r.id in focus:
+                    route_demands(ctx, oracle, r)
+            if pairs:
+                pair_conflicts(ctx, oracle, focus)
+                for a, b in work.asymmetric:
+                    ctx.record(False, "conflict-symmetry", f"{a} + {b}", "the table lists the conflict on one route "
+                               "only")
+            if not focus:
+                approach_extent(ctx)
+            check_station(ctx, focus)
+            with progress(f"verify {st.id}", len(work.units), show=show_progress) as advance:
+                if workers and not stop_at_first:
+                    results = spread_units(bench, work.units, workers, scheduler, advance)
+                else:
+                    results = list(run_here(bench, work.units, stop_at_first=stop_at_first, done=advance))
+        except FirstFailure:  # in the checks against the oracle (the units stop by themselves)
+            pass
+    checks, failures, warnings = merge([UnitResult(ctx.checks, ctx.failures, ctx.warnings), *results])
+    return VerifyReport(st.id, st.display_name(), len(table.routes),
+                        sum(1 for u in work.units if u.kind == "route"), work.pairs_tested, work.pairs_conflicting,
+                        work.pairs_compatible, checks, failures, warnings,
+                        [r.route for r in results if isinstance(r.route, RouteResult)], table,
+                        time.perf_counter() - t0, strict)
 
 
 def report_text(rep: VerifyReport, *, verbose: bool = False) -> str:

@@ -1,4 +1,5 @@
-"""``liansuo verify STATION [--format text|json] [--strict] [--route ID ...] [--no-pairs] [-v]``."""
+"""``liansuo verify STATION [--format text|json] [--strict] [--route ID ...] [--no-pairs] [-v] [--workers N]
+[--scheduler ADDRESS]``."""
 
 from __future__ import annotations
 
@@ -16,7 +17,9 @@ def cmd_verify(args: argparse.Namespace) -> int:
     from . import report_text, verify_station
 
     try:
-        rep = verify_station(args.station, routes=args.route, pairs=not args.no_pairs, strict=args.strict)
+        rep = verify_station(args.station, routes=args.route, pairs=not args.no_pairs, strict=args.strict,
+                             workers=args.workers or (1 if args.scheduler else 0), scheduler=args.scheduler,
+                             show_progress=None)
     except StationError as exc:
         for d in exc.diagnostics:
             print(d, file=sys.stderr)
@@ -37,4 +40,8 @@ def register(add: Add) -> None:
     sp.add_argument("--route", action="append", metavar="ID", help="test only this route and its pairs (repeatable)")
     sp.add_argument("--no-pairs", action="store_true", help="skip the pairs of routes")
     sp.add_argument("-v", "--verbose", action="store_true", help="print the steps that reproduce each failure")
+    sp.add_argument("--workers", type=int, default=0, metavar="N",
+                    help="fan the test out on Dask over N local worker processes (default: run here, in one)")
+    sp.add_argument("--scheduler", metavar="ADDRESS",
+                    help="run on the Dask cluster whose scheduler is at ADDRESS (tcp://host:8786); docs/cluster.md")
     sp.set_defaults(handler=cmd_verify)

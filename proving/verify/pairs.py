@@ -1,16 +1,15 @@
 """Pairs of routes: conflicting routes (敌对进路) can never be locked together, compatible ones can.
 
-Each route in turn is set on a fresh simulation. Every route that conflicts with it must then be refused, both while
-it is still setting and once its signal is open (so each conflicting pair is tried both ways round; a refused
-command changes nothing, so they can all be tried on the one simulation). Then every compatible route after it in
-the table is set as well: both signals must be open together (with their liaison given); it is cancelled again
-before the next. A failure is replayed on a fresh simulation, so its script shows just the two routes.
+Enemies (:meth:`PairTest.rivals`): a route is set on a fresh simulation; every route that conflicts with it must then
+be refused, both while it is still setting and once its signal is open (so each conflicting pair is tried both ways
+round). A refused command changes nothing and takes no time, so they are all tried on the one simulation.
+
+Compatible routes (:meth:`PairTest.batch`): a group of pairwise compatible routes (:func:`.plan.cover`) is set
+together on a fresh simulation; every signal open together proves every pair of the group. A group that does not all
+open is tried pair by pair, so a failure is replayed on a fresh simulation and its script shows just the two routes.
 """
 
 from __future__ import annotations
-
-from collections.abc import Iterable
-from functools import partial
 
 from liansuo.interlocking.table import Route
 from liansuo.stations.schema import TurnoutPosition
@@ -18,52 +17,27 @@ from liansuo.stations.schema import TurnoutPosition
 from .probe import Context, Probe, open_route, prepare, route_line
 
 SETTLE_S = 30.0
-
-
-def released(p: Probe, r: Route) -> bool:
-    return p.state(r) == "released"
-
-
-def conflicting(a: Route, b: Route) -> bool:
-    return b.id in a.conflicts or a.id in b.conflicts or a.signal == b.signal
-
-
-def conditional(a: Route, b: Route) -> bool:
-    """Enemies only for some ways the turnouts beyond a shunting route's end lie."""
-    return b.id in a.conditional or a.id in b.conditional
+MOVE_S = 8.0  # a turnout move with its indication, allowed per round of moves the interlocking drives at once
 
 
 class PairTest:
     def __init__(self, ctx: Context) -> None:
         self.ctx = ctx
-        self.tested = 0
-        self.conflicting = 0
-        self.compatible = 0
 
-    def run(self, routes: Iterable[Route], focus: set[str] | None = None) -> None:
-        order = list(routes)
-        for i, a in enumerate(order):
-            rivals = [b for b in order if b is not a and conflicting(a, b) and (not focus or {a.id, b.id} & focus)]
-            later = [b for b in order[i + 1:] if not conflicting(a, b) and not conditional(a, b)
-                     and (not focus or {a.id, b.id} & focus)]
-            for b in order[i + 1:]:
-                if focus and a.id not in focus and b.id not in focus:
-                    continue
-                self.tested += 1
-                if conflicting(a, b):
-                    self.conflicting += 1
-                elif conditional(a, b):
-                    self.conflicting += 1
-                    self.compatible += 1
-                    self.conditionally(a, b)
-                else:
-                    self.compatible += 1
-                if (b.id in a.conflicts) != (a.id in b.conflicts) or (b.id in a.conditional) != (
-                        a.id in b.conditional):
-                    self.ctx.record(False, "conflict-symmetry", f"{a.id} + {b.id}",
-                                    "the table lists the conflict on one route only")
-            if rivals or later:
-                self.first(a, rivals, later)
+    def batch(self, routes: list[Route], pairs: list[tuple[Route, Route]]) -> None:
+        """``routes`` set together all open: each of ``pairs`` is proved; otherwise each pair is tried alone."""
+        p = Probe(self.ctx)
+        moves = len({t.id for r in routes for t in r.all_turnouts})
+        timeout = SETTLE_S + MOVE_S * (moves // self.ctx.rules.turnout_concurrency + 1)
+        if open_route(p, *routes, timeout_s=timeout):
+            for a, b in pairs:
+                self.ctx.record(True, "compatible", f"{a.id} + {b.id}", "")
+            return
+        for a, b in pairs:
+            p = Probe(self.ctx)
+            ok = open_route(p, a, b, timeout_s=SETTLE_S)
+            self.ctx.record(ok, "compatible", f"{a.id} + {b.id}", f"{a.id} and {b.id} do not conflict but could not "
+                            f"both be set and open: {p.blocker(a)}; {p.blocker(b)}", p)
 
     def conditionally(self, a: Route, b: Route) -> None:
         """A pair that conflicts only for some ways the turnouts beyond a shunting route's end lie: with them lying
@@ -95,7 +69,8 @@ class PairTest:
     def why(self, a: Route, b: Route) -> str:
         return a.conflicts.get(b.id) or b.conflicts.get(a.id) or f"both start at {a.signal}"
 
-    def first(self, a: Route, rivals: list[Route], later: list[Route]) -> None:
+    def rivals(self, a: Route, rivals: list[Route]) -> None:
+        """``a`` set on a fresh station: every route in ``rivals`` is refused while it sets and once it is open."""
         p = Probe(self.ctx)
         prepare(p, a)
         if not self.ctx.record(p.do(route_line(a)).ok, "pair-setup", a.id,
@@ -106,19 +81,7 @@ class PairTest:
         if not p.until(lambda: p.state(a) == "open", SETTLE_S):
             self.ctx.record(False, "pair-setup", a.id, f"signal {a.signal} did not open: {p.blocker(a)}", p)
             return
-        if not self._rivals_refused(p, a, rivals, "open"):
-            return
-        for b in later:
-            ok = open_route(p, b, timeout_s=SETTLE_S) and p.state(a) == "open"
-            if ok:
-                self.ctx.record(True, "compatible", f"{a.id} + {b.id}", "")
-            else:
-                self.replay_together(a, b)
-            result = p.do(f"cancel {b.signal}")
-            if not result.ok or not p.until(partial(released, p, b), 5.0) or p.state(a) != "open":
-                p = Probe(self.ctx)  # could not get back to 'a alone': start again for the rest
-                if not open_route(p, a, timeout_s=SETTLE_S):
-                    return
+        self._rivals_refused(p, a, rivals, "open")
 
     def _rivals_refused(self, p: Probe, a: Route, rivals: list[Route], when: str) -> bool:
         """Every conflicting route is refused while ``a`` is ``when``; a failure is replayed and recorded."""
@@ -141,14 +104,6 @@ class PairTest:
         self.ctx.record(False, "conflict", f"{a.id} + {b.id}", f"{b.id} conflicts with {a.id} ({self.why(a, b)}) "
                         f"but was accepted with {a.id} {when}" + ("" if result.ok else " (only after the routes "
                                                                   "tried before it)"), p)
-
-    def replay_together(self, a: Route, b: Route) -> None:
-        p = Probe(self.ctx)
-        ok = open_route(p, a, b, timeout_s=SETTLE_S)
-        detail = f"{p.blocker(a)}; {p.blocker(b)}"
-        self.ctx.record(False, "compatible", f"{a.id} + {b.id}", f"{a.id} and {b.id} do not conflict but could not "
-                        f"both be set and open: {detail}" + (" (only after the routes tried before it)" if ok else ""),
-                        p)
 
 
 def _ways(a: Route, b: Route) -> list[dict[str, TurnoutPosition]]:

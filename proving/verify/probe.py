@@ -29,6 +29,7 @@ class Failure:
     subject: str  # route id, "A + B" for a pair, or a station item
     detail: str
     steps: list[str] = field(default_factory=list)
+    key: str = ""  # what the oracle found (its text without the time): reported once per run
 
     def as_dict(self) -> dict[str, object]:
         return {"check": self.check, "subject": self.subject, "detail": self.detail, "steps": list(self.steps)}
@@ -80,7 +81,7 @@ class Probe:
         for v in found[self._reported:]:
             if v.text not in self.ctx.oracle_seen:
                 self.ctx.oracle_seen.add(v.text)
-                self.ctx.fail(Failure("oracle", v.prop, f"at t = {v.t:g} s: {v.text}", self.script()))
+                self.ctx.fail(Failure("oracle", v.prop, f"at t = {v.t:g} s: {v.text}", self.script(), v.text))
         self._reported = len(found)
 
     # ---- driving ------------------------------------------------------------------------------------------------

@@ -1,0 +1,185 @@
+"""The interlocking test cut into units of work that run on their own simulations, in any order, on any worker.
+
+A :class:`Unit` is one route's items, one route's enemies (its rivals refused with it setting and open), one batch
+of mutually compatible routes set and open together, one conditionally conflicting pair, or one station-wide item.
+:func:`plan` lists them in a fixed order for a station and a focus; the report is put together in that order,
+whatever ran where (:mod:`.spread`).
+
+Compatible pairs are proven in batches, not one at a time: :func:`cover` finds groups of routes that are pairwise
+compatible (cliques of the compatibility graph) until every compatible pair lies in one group. Setting a group's
+routes together and seeing every signal open proves each of its pairs; a group that does not open is tried again
+pair by pair, so a failure still comes with the script of just its two routes.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass, field
+
+from liansuo.interlocking.table import InterlockingTable, Route
+
+from .probe import Failure
+
+MAX_BATCH = 40  # routes set together at most: their turnout moves queue (a few at a time), so time grows with it
+_LOOK = 32  # candidates weighed for each place in a batch (more: fewer batches, longer planning)
+
+
+def conflicting(a: Route, b: Route) -> bool:
+    return b.id in a.conflicts or a.id in b.conflicts or a.signal == b.signal
+
+
+def conditional(a: Route, b: Route) -> bool:
+    """Enemies only for some ways the turnouts beyond a shunting route's end lie."""
+    return b.id in a.conditional or a.id in b.conditional
+
+
+@dataclass(frozen=True)
+class Unit:
+    """One independent piece of the test. ``kind``: route, rivals, batch, conditional or station; ``routes``: the
+    routes it is about (a batch: all its routes); ``pairs``: the compatible pairs a batch proves (each pair is
+    proved by exactly one batch); ``item``: which station-wide item."""
+
+    kind: str
+    routes: tuple[str, ...] = ()
+    pairs: tuple[tuple[str, str], ...] = ()
+    item: str = ""
+
+
+@dataclass
+class Plan:
+    units: list[Unit]
+    pairs_tested: int = 0
+    pairs_conflicting: int = 0
+    pairs_compatible: int = 0
+    asymmetric: list[tuple[str, str]] = field(default_factory=list)  # conflicts listed on one route only
+
+
+STATION_ITEMS = ("throats", "power-up", "red-lamp-transfer")
+
+
+def plan(table: InterlockingTable, focus: set[str] | None, *, pairs: bool) -> Plan:
+    """Every unit of the test of ``table``, in report order (see the module docstring)."""
+    order = list(table.routes.values())
+    units = [Unit("route", (r.id,)) for r in order if not focus or r.id in focus]
+    out = Plan([])
+    if pairs:
+        out = _pairs(order, focus)
+    out.units[:0] = units
+    if not focus:
+        out.units += [Unit("station", item=item) for item in STATION_ITEMS]
+    return out
+
+
+def _pairs(order: list[Route], focus: set[str] | None) -> Plan:
+    def relevant(a: Route, b: Route) -> bool:
+        return not focus or a.id in focus or b.id in focus
+
+    out = Plan([])
+    rivals: list[Unit] = []
+    conditionals: list[Unit] = []
+    compatible: list[tuple[int, int]] = []
+    for i, a in enumerate(order):
+        mine = [b.id for b in order if b is not a and conflicting(a, b) and relevant(a, b)]
+        if mine:
+            rivals.append(Unit("rivals", (a.id, *mine)))
+        for j in range(i + 1, len(order)):
+            b = order[j]
+            if not relevant(a, b):
+                continue
+            out.pairs_tested += 1
+            if conflicting(a, b):
+                out.pairs_conflicting += 1
+            elif conditional(a, b):
+                out.pairs_conflicting += 1
+                out.pairs_compatible += 1
+                conditionals.append(Unit("conditional", (a.id, b.id)))
+            else:
+                out.pairs_compatible += 1
+                compatible.append((i, j))
+            if (b.id in a.conflicts) != (a.id in b.conflicts) or (b.id in a.conditional) != (a.id in b.conditional):
+                out.asymmetric.append((a.id, b.id))
+    ids = [r.id for r in order]
+    batches = [Unit("batch", tuple(ids[k] for k in group), tuple((ids[x], ids[y]) for x, y in proved))
+               for group, proved in cover(len(order), compatible)]
+    out.units = rivals + batches + conditionals
+    return out
+
+
+def cover(n: int, edges: Iterable[tuple[int, int]], max_size: int = MAX_BATCH
+          ) -> list[tuple[list[int], list[tuple[int, int]]]]:
+    """Groups of pairwise-adjacent vertices (cliques) of the graph on ``range(n)`` with ``edges`` until every edge
+    lies in a group; each group comes with the edges it is the first to cover. Greedy and deterministic: a group
+    starts at the vertex with the most uncovered edges and grows by the candidate (of the first few that would cover
+    something new) that keeps the most uncovered edges within reach. Adjacency is kept as Python integers used as
+    bit sets."""
+    adj = [0] * n
+    for a, b in edges:
+        adj[a] |= 1 << b
+        adj[b] |= 1 << a
+    left = list(adj)  # uncovered edges at each vertex
+    remaining = sum(x.bit_count() for x in left) // 2
+    groups: list[tuple[list[int], list[tuple[int, int]]]] = []
+    while remaining:
+        seed = max(range(n), key=lambda v: (left[v].bit_count(), -v))
+        group, members = [seed], 1 << seed
+        reach = adj[seed]  # vertices adjacent to every member
+        useful = left[seed]  # vertices with an uncovered edge to some member
+        while len(group) < max_size:
+            pool = reach & useful
+            if not pool:
+                break
+            # the candidate covering the most new pairs with the group, then keeping the most within reach
+            best = max(_first_bits(pool, _LOOK), key=lambda v: ((left[v] & members).bit_count(),
+                                                              (left[v] & reach).bit_count(), -v))
+            group.append(best)
+            members |= 1 << best
+            reach &= adj[best]
+            useful |= left[best]
+        proved: list[tuple[int, int]] = []
+        for v in group:
+            new = left[v] & members
+            proved += [(v, w) for w in _bits(new) if v < w]
+            left[v] &= ~members
+        remaining -= len(proved)
+        groups.append((sorted(group), sorted(proved)))
+    return groups
+
+
+def _first_bits(x: int, k: int) -> list[int]:
+    out: list[int] = []
+    while x and len(out) < k:
+        low = x & -x
+        out.append(low.bit_length() - 1)
+        x ^= low
+    return out
+
+
+def _bits(x: int) -> list[int]:
+    return _first_bits(x, x.bit_count())
+
+
+@dataclass
+class UnitResult:
+    """What one unit found: its checks, failures and warnings in the order made, and a route unit's tally."""
+
+    checks: int = 0
+    failures: list[Failure] = field(default_factory=list)
+    warnings: list[Failure] = field(default_factory=list)
+    route: object = None  # a RouteResult for a route unit
+
+
+def merge(results: Sequence[UnitResult]) -> tuple[int, list[Failure], list[Failure]]:
+    """Checks, failures and warnings of units taken in plan order; what the oracle found is reported once, at the
+    first unit that met it (as one run in order would), so the report is the same however the units ran."""
+    checks, failures, warnings = 0, [], []
+    seen: set[str] = set()
+    for res in results:
+        checks += res.checks
+        for f in res.failures:
+            if f.key:
+                if f.key in seen:
+                    continue
+                seen.add(f.key)
+            failures.append(f)
+        warnings += res.warnings
+    return checks, failures, warnings

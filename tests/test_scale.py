@@ -1,0 +1,112 @@
+"""Scale (issue 13): the hub generator on the command line, compatible pairs proved in batches, verify and soak fanned
+out on Dask with the same report, the table written row by row and the same on every run."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from itertools import combinations
+from pathlib import Path
+
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from liansuo.interlocking.table import build_table
+from liansuo.interlocking.tableformat import as_json
+from liansuo.proving.progress import progress
+from liansuo.proving.soakcli import soak_runs
+from liansuo.proving.verify import verify_station
+from liansuo.proving.verify.plan import cover, plan
+from liansuo.stations.loader import load, load_text
+
+LIANSUO = [sys.executable, "-m", "liansuo.cli"]
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(2, 14).flatmap(lambda n: st.tuples(st.just(n), st.sets(
+    st.tuples(st.integers(0, n - 1), st.integers(0, n - 1)).filter(lambda e: e[0] < e[1])))),
+    st.integers(2, 6))
+def test_the_cover_proves_every_compatible_pair_exactly_once_in_groups_of_compatible_routes(
+        graph: tuple[int, set[tuple[int, int]]], size: int) -> None:
+    n, edges = graph
+    groups = cover(n, sorted(edges), max_size=size)
+    proved = [e for _, new in groups for e in new]
+    assert sorted(proved) == sorted(edges)  # every edge, once
+    for group, new in groups:
+        assert len(group) <= size
+        assert all(pair in edges for pair in combinations(sorted(group), 2))  # pairwise compatible
+        assert all(a in group and b in group for a, b in new)
+    assert cover(n, sorted(edges), max_size=size) == groups  # the same plan every time
+
+
+def test_the_plan_covers_the_table_with_batches_and_counts_every_pair() -> None:
+    table = build_table(load("jiaopei"))
+    work = plan(table, None, pairs=True)
+    routes = list(table.routes.values())
+    assert work.pairs_tested == len(routes) * (len(routes) - 1) // 2
+    batches = [u for u in work.units if u.kind == "batch"]
+    proved = sorted(tuple(sorted(p)) for u in batches for p in u.pairs)
+    compatible = sorted(tuple(sorted((a.id, b.id))) for a, b in combinations(routes, 2)
+                        if b.id not in a.conflicts and a.id not in b.conflicts and a.signal != b.signal
+                        and b.id not in a.conditional and a.id not in b.conditional)
+    assert proved == compatible
+    assert len(batches) < len(compatible)  # batches prove several pairs at once
+    assert [u.item for u in work.units if u.kind == "station"] == ["throats", "power-up", "red-lamp-transfer"]
+
+
+def test_verify_on_two_dask_workers_reports_exactly_what_one_process_does() -> None:
+    here = verify_station("gaotie").as_dict()
+    spread = verify_station("gaotie", workers=2).as_dict()
+    assert here.pop("elapsed_s") is not None and spread.pop("elapsed_s") is not None
+    assert here["warnings"], "gaotie's dead-zone warnings should be in both reports"
+    assert here == spread
+
+
+def test_soak_runs_on_workers_are_the_runs_made_here_in_seed_order() -> None:
+    here = soak_runs("jiaopei", 150, [3, 4])
+    spread = soak_runs("jiaopei", 150, [3, 4], workers=2)
+    for r in (*here, *spread):
+        r.pop("elapsed_s")
+    assert [r["seed"] for r in spread] == [3, 4]
+    assert here == spread
+
+
+def test_generate_hub_writes_a_station_that_loads(tmp_path: Path) -> None:
+    out = tmp_path / "hub.yaml"
+    done = subprocess.run([*LIANSUO, "generate", "hub", "--turnouts", "30", "--tracks", "12", "-o", str(out)],
+                          capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    station = load(str(out))
+    assert len(station.turnouts) == 30 and "wrote" in done.stderr
+    piped = subprocess.run([*LIANSUO, "generate", "hub", "--turnouts", "30", "--tracks", "12"], capture_output=True,
+                           text=True, check=True).stdout
+    assert piped == out.read_text(encoding="utf-8") and load_text(piped).id == station.id
+
+
+def test_generate_hub_refuses_numbers_that_make_no_hub_and_writes_nothing(tmp_path: Path) -> None:
+    out = tmp_path / "hub.yaml"
+    done = subprocess.run([*LIANSUO, "generate", "hub", "--turnouts", "10", "--tracks", "40", "-o", str(out)],
+                          capture_output=True, text=True)
+    assert done.returncode == 2 and "40 tracks need at least 78 turnouts" in done.stderr
+    assert not out.exists() and "Traceback" not in done.stderr
+
+
+def test_the_table_is_the_same_on_every_run() -> None:
+    """Conflict reasons used to depend on the order of a set of section names (Python's string hashing)."""
+    outs = set()
+    for seed in ("1", "2", "3"):
+        env = {**os.environ, "PYTHONHASHSEED": seed}
+        outs.add(subprocess.run([*LIANSUO, "table", "jiaopei", "--format", "json"], capture_output=True, text=True,
+                                env=env, check=True).stdout)
+    assert len(outs) == 1
+    assert json.loads(outs.pop()) == json.loads(as_json(build_table(load("jiaopei"))))
+
+
+def test_progress_is_silent_when_not_asked_for() -> None:
+    with progress("work", 10, show=False) as advance:
+        advance(10)
+    done = subprocess.run([*LIANSUO, "verify", "jiaopei", "--route", "X-XI", "--no-pairs"], capture_output=True,
+                          text=True)
+    assert done.returncode == 0 and done.stderr == ""  # stderr is a pipe here: no bar
