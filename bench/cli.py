@@ -1,4 +1,4 @@
-"""``liansuo bench [--quick] [--format json|text]``."""
+"""``liansuo bench [--quick] [--scale] [--format json|text]``."""
 
 from __future__ import annotations
 
@@ -11,10 +11,12 @@ Add = Callable[..., argparse.ArgumentParser]
 def cmd_bench(args: argparse.Namespace) -> int:
     from .report import main  # the benchmark loads the whole simulation: only when it runs
 
-    return main(quick=args.quick, fmt=args.format)
+    return main(quick=args.quick, fmt=args.format, scale=args.scale)
 
 
 def register(add: Add) -> None:
     sp = add("bench", cmd_bench, "benchmark table building and the interlocking cycle (hub and jiaopei)")
     sp.add_argument("--quick", action="store_true", help="fewer cycles (under a minute)")
     sp.add_argument("--format", choices=("json", "text"), default="json")
+    sp.add_argument("--scale", action="store_true", help="also verify, soak and write the table of large hubs "
+                    "(hours in full; with --quick minutes): docs/benchmark.md")

@@ -10,11 +10,13 @@ from dataclasses import dataclass
 from typing import Any
 
 from liansuo.interlocking.table import build_table
+from liansuo.proving.progress import Advance, progress
 from liansuo.stations.hubgen import generate_hub
 from liansuo.stations.loader import load_text
 
 from .busy import BUSY_ROUTES
 from .machine import machine
+from .scale import ScaleSizes, measure_scale
 from .station import measure
 from .trains import TARGET_TRAINS, run_trains, trains_text
 from .zpw import ZPW_TARGET_CONFIGS_PER_S, measure_zpw
@@ -69,9 +71,18 @@ def _check_targets(results: dict[str, dict[str, Any]]) -> list[dict[str, Any]]:
 
 
 def run_bench(sizes: Sizes | None = None, *, quick: bool = False, stations: tuple[str, ...] = ("jiaopei", "hub"),
-              ) -> dict[str, Any]:
-    """Run the benchmark and return every figure (see the module docstring and docs/benchmark.md)."""
+              scale: ScaleSizes | None = None, show_progress: bool | None = False) -> dict[str, Any]:
+    """Run the benchmark and return every figure (see the module docstring and docs/benchmark.md); with ``scale``
+    also the figures of :mod:`.scale` (verify, soak and the table at hub size). ``show_progress``: a bar of the
+    parts on stderr (None: when it is a terminal)."""
     sizes = sizes or (Sizes.quick() if quick else Sizes())
+    parts = len(stations) + 2 + (scale is not None)
+    with progress("bench", parts, show=show_progress) as advance:
+        return _run(sizes, quick, stations, scale, advance)
+
+
+def _run(sizes: Sizes, quick: bool, stations: tuple[str, ...], scale: ScaleSizes | None, advance: Advance
+         ) -> dict[str, Any]:
     start = time.perf_counter()
     results: dict[str, dict[str, Any]] = {}
     for key in stations:  # the small station first, so its peak memory is its own
@@ -85,8 +96,13 @@ def run_bench(sizes: Sizes | None = None, *, quick: bool = False, stations: tupl
             results[key] = measure(key, label=key, text=False, idle_cycles=sizes.idle_cycles * sizes.small_factor,
                                    busy_cycles=sizes.busy_cycles * sizes.small_factor,
                                    routes_limit=sizes.busy_routes, warmup_limit=sizes.warmup_limit)
+        advance(1)
+    scaled = measure_scale(scale) if scale is not None else None
+    advance(1 if scale is not None else 0)
     zpw = measure_zpw(sizes.zpw_repeats)
+    advance(1)
     trains = _trains(sizes) if "hub" in stations and sizes.train_cycles > 0 else None
+    advance(1)
     targets = _check_targets(results)
     targets.append({"station": "zpw", "figure": "zpw_configs_per_s", "target": f">= {ZPW_TARGET_CONFIGS_PER_S:g}",
                     "value": zpw["zpw_configs_per_s"], "met": zpw["zpw_configs_per_s"] >= ZPW_TARGET_CONFIGS_PER_S})
@@ -102,7 +118,8 @@ def run_bench(sizes: Sizes | None = None, *, quick: bool = False, stations: tupl
         "results": results,
         "zpw": zpw,
         **({"trains": trains} if trains is not None else {}),
-        "targets": targets,
+        **({"scale": scaled} if scaled is not None else {}),
+        "targets": targets + [{"station": "hub", **t} for t in (scaled or {}).get("targets", [])],
         "total_s": round(time.perf_counter() - start, 2),
     }
 
@@ -153,6 +170,10 @@ def as_text(report: dict[str, Any]) -> str:
                      f"{z['evaluate_us_train64']:.0f} us)")
     if report.get("trains"):
         lines += trains_text(report["trains"])
+    sc = report.get("scale")
+    if sc:
+        lines.append("scale:")
+        lines += [f"  {k:34} {v}" for k, v in sc.items() if k != "targets"]
     lines.append("targets:")
     for t in report["targets"]:
         lines.append(f"  {t['station']:10} {t['figure']:16} {t['target']:>8}  measured {t['value']:g}  "
@@ -161,7 +182,8 @@ def as_text(report: dict[str, Any]) -> str:
     return "\n".join(lines)
 
 
-def main(quick: bool = False, fmt: str = "json") -> int:
-    report = run_bench(quick=quick)
+def main(quick: bool = False, fmt: str = "json", scale: bool = False) -> int:
+    sizes = (ScaleSizes.quick() if quick else ScaleSizes()) if scale else None
+    report = run_bench(quick=quick, scale=sizes, show_progress=None)
     print(json.dumps(report, indent=2) if fmt == "json" else as_text(report))
     return 0

@@ -93,7 +93,8 @@ class SectionCircuit:
         if isinstance(self.model, AxleCounter):
             self.up = self.model.clear(self._inside) and not self.k_switch
             return self.up
-        if shunts and not f.any() and min(r for _, r in shunts) <= self.standard_shunt_ohm:
+        std = self.standard_shunt_ohm
+        if shunts and not f.any() and any(r <= std for _, r in shunts):
             # a healthy circuit with a standard (or better) shunt on it: down by design; solve only if asked
             self._stale = list(shunts)
             self.up = False

@@ -281,12 +281,13 @@ class Core:
         if any(rs.released):
             released = [s for i, s in enumerate(rs.sections) if rs.released[i]]
             return f"section {released[0]} of route {r.id} has been released: the route is no longer locked"
-        for t in rs.all_turnouts:
+        own = len(rs.turnouts)  # the route's own turnouts come first and must be locked by it; the overlap's after
+        for i, t in enumerate(rs.all_turnouts):
             ind = self.board.indication(t.id)
             if ind != t.position.value:
                 what = "has no indication" if ind is None else f"is {ind}"
                 return f"turnout {t.id} {what}, the route needs it {t.position.value}"
-            if t in rs.turnouts and rs.id not in self.locks.holders(t.id):
+            if i < own and rs.id not in self.locks.holders(t.id):
                 return f"turnout {t.id} is not locked in route {r.id}"
         if not guide:
             skip = 0

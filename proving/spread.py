@@ -32,7 +32,7 @@ def client(workers: int, scheduler: str | None) -> Iterator[Any]:
             yield c
         return
     cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,  # type: ignore[no-untyped-call]
-                           dashboard_address=None, silence_logs=logging.ERROR)
+                           dashboard_address=":0", silence_logs=logging.ERROR)  # any free port
     with cluster, Client(cluster) as c:  # type: ignore[no-untyped-call]
         yield c
 

@@ -73,6 +73,7 @@ class Topology:
     def __init__(self, station: Network) -> None:
         self.station = station
         self.graph = nx.DiGraph()
+        self._next: dict[Move, list[tuple[Move, dict[str, object]]]] = {}
         st = station
         for tid in st.tracks:
             for d in Direction:
@@ -104,7 +105,11 @@ class Topology:
         return port.node
 
     def next_moves(self, move: Move) -> list[tuple[Move, dict[str, object]]]:
-        return [(nxt, data) for _, nxt, data in self.graph.out_edges(move, data=True)]
+        """The moves that can follow ``move`` (the graph never changes: looked up once per move; read only)."""
+        found = self._next.get(move)
+        if found is None:
+            found = self._next[move] = [(nxt, data) for _, nxt, data in self.graph.out_edges(move, data=True)]
+        return found
 
     def start_move(self, node: str, direction: Direction) -> Move:
         return (self.station.entry_track(node, direction), direction)

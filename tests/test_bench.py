@@ -61,7 +61,8 @@ def test_text_format_lists_every_station(report: dict[str, object]) -> None:
 
 
 def test_cli_bench_prints_json(monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
-    monkeypatch.setattr(bench, "run_bench", lambda quick=False: run_bench(Sizes.tiny(), quick=quick))
+    monkeypatch.setattr(bench, "run_bench",
+                        lambda quick=False, scale=None, show_progress=None: run_bench(Sizes.tiny(), quick=quick))
     assert main(["bench", "--quick"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["mode"] == "quick" and set(out["results"]) == {"hub", "jiaopei"}
@@ -100,3 +101,14 @@ def test_impossible_hub_is_refused() -> None:
         generate_hub(5, 4)
     with pytest.raises(ValueError, match="cannot be laid out"):
         generate_hub(30, 4)
+
+
+def test_the_scale_figures_are_reported_for_verify_soak_and_the_table() -> None:
+    from liansuo.bench.scale import ScaleSizes, measure_scale
+
+    sc = measure_scale(ScaleSizes.tiny())
+    assert sc["verify_hub8"]["ok"] and sc["verify_hub8"]["pairs"] > 0 and sc["verify_hub8_s"] > 0
+    assert sc["verify_speedup_hub"]["reports_identical"]  # 1 and 2 workers: the same report
+    assert 0 < sc["table_hub8_peak_mb"] < 1000 and sc["table_hub8_json_mb"] > 0
+    assert sc["soak_steps_per_s_per_worker"]["here"] > 0 and sc["soak_steps_per_s_per_worker"]["two_workers"] > 0
+    assert {t["figure"] for t in sc["targets"]} == {"verify_speedup"}  # the hub sizes of the targets are not run

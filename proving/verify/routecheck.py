@@ -7,11 +7,16 @@ neither needs the other.
 
 from __future__ import annotations
 
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass, field
+from typing import TypeVar
 
 from liansuo.interlocking.table import Route
 
 from .probe import Context, Probe, open_route
+
+T = TypeVar("T")
 
 
 @dataclass
@@ -44,6 +49,48 @@ class RouteCheck:
         if not ok:
             self.res.failures += 1
         return self.ctx.record(ok, check, self.r.id, detail, p)
+
+    @contextmanager
+    def trial(self) -> Iterator[Context]:
+        """Checks made inside go to a scratch tally (yielded), not to the run's."""
+        ctx, res = self.ctx, self.res
+        self.ctx = Context(ctx.station, ctx.table, ctx.rules, ctx.cycle_s)
+        self.res = RouteResult(res.id, order=res.order)
+        try:
+            yield self.ctx
+        finally:
+            self.ctx, self.res = ctx, res
+
+    def in_turn(self, items: Sequence[T], start: Callable[[], Probe | None], one: Callable[[Probe, T], bool],
+                alone: Callable[[T], None]) -> None:
+        """The check of each item, one after the other on one simulation from ``start()`` (a refused command changes
+        nothing; a signal reopened after a fault is as it was), while they pass: ``one(p, item)`` says whether the
+        simulation is still as it was before the item. An item that fails there, or leaves it otherwise, is checked
+        ``alone`` on fresh simulations, as every item used to be, so its failure comes with its own script; the
+        next item starts a fresh shared simulation. What the oracle saw on a shared simulation is kept even when the
+        item alone does not show it."""
+        p: Probe | None = None
+        for item in items:
+            with self.trial() as scratch:
+                if p is None:
+                    p = start()
+                elif p is not None:
+                    p.ctx = scratch  # what the oracle finds goes with this item
+                clean = p is not None and one(p, item)
+                tally = self.res
+            if clean and not scratch.failures:
+                self.ctx.checks += scratch.checks
+                self.res.checks += tally.checks
+                self.res.aspects_seen |= tally.aspects_seen
+                continue
+            p = None
+            before = len(self.ctx.failures)
+            alone(item)
+            if len(self.ctx.failures) == before:
+                for f in scratch.failures:
+                    if f.check == "oracle":
+                        self.res.failures += 1
+                        self.ctx.fail(f)
 
     def opened(self, p: Probe, check: str) -> bool:
         """Open the route on a fresh probe; a failure to open is recorded under ``check``."""

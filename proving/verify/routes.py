@@ -23,17 +23,94 @@ class RouteTest(RouteCheck):
     """All checks of one route; ``run()`` returns its tally."""
 
     def run(self) -> RouteResult:
+        """Every item; the items of each turnout and section run in turn on shared simulations where a check leaves
+        it as it was (:meth:`~.routecheck.RouteCheck.in_turn`), else on fresh ones."""
         self.opens_from_the_other_positions()
         self.liaison()
-        for t, pos in turnout_groups(self.ctx.station, self.r):
-            self.turnout_out_of_position(t, pos)
-            self.turnout_obstructed(t, pos)
-        for rt in self.r.all_turnouts:
-            self.no_indication(rt.id)
-        for s in self.r.all_sections:
-            self.section_occupied(s)
+        groups = turnout_groups(self.ctx.station, self.r)
+        self.in_turn(groups, self.fresh, self.out_of_position_on, lambda g: self.turnout_out_of_position(*g))
+        self.in_turn(groups, self.fresh, self.obstructed_on, lambda g: self.turnout_obstructed(*g))
+        turnouts = [rt.id for rt in self.r.all_turnouts]
+        sections = list(self.r.all_sections)
+        self.in_turn(turnouts, self.fresh, self.without_indication_on, self.without_indication)
+        self.in_turn(turnouts, self.open_probe, self.indication_lost_on, self.indication_lost)
+        self.in_turn(sections, self.fresh, self.occupied_refused_on, self.occupied_refused)
+        self.in_turn(sections, self.open_probe, self.occupied_closes_on, self.occupied_closes)
         ReleaseChecks(self).run()
         return self.res
+
+    # ---- shared simulations ---------------------------------------------------------------------------------------
+    def fresh(self) -> Probe:
+        p = Probe(self.ctx)
+        prepare(p, self.r)
+        return p
+
+    def open_probe(self) -> Probe | None:
+        p = Probe(self.ctx)
+        return p if self.opened(p, "opens") else None
+
+    def out_of_position_on(self, p: Probe, group: tuple[str, str]) -> bool:
+        """:meth:`turnout_out_of_position` without the wait: the refused route changed nothing. The turnout is
+        unlocked again after it (it may stay where it lies: the route moves it)."""
+        t, pos = group
+        r = self.r
+        p.do(f"throw {t} {other(pos)}")
+        if not p.until(lambda: p.sim.turnout_state(t)[0] == other(pos), SETTLE_S):
+            return False
+        p.do(f"lock {t}")
+        result = p.do(route_line(r))
+        self.check(not result.ok and p.closed(r.signal), "turnout-out-of-position",
+                   f"turnout {t} single-locked {other(pos)}: '{route_line(r)}' was "
+                   f"{'accepted' if result.ok else 'refused'} and signal {r.signal} shows {p.aspect(r.signal)}", p)
+        return not result.ok and p.do(f"unlock {t}").ok
+
+    def obstructed_on(self, p: Probe, group: tuple[str, str]) -> bool:
+        """:meth:`turnout_obstructed`, then the route cancelled and the obstruction cleared."""
+        t, pos = group
+        r = self.r
+        p.do(f"throw {t} {other(pos)}")
+        if not p.until(lambda: p.sim.turnout_state(t)[0] == other(pos), SETTLE_S):
+            return False
+        p.do(f"fault obstruction {t}")
+        p.do(route_line(r))
+        p.run(SETTLE_S)
+        self.check(p.closed(r.signal), "turnout-obstructed", f"turnout {t} obstructed on its way {pos}: signal "
+                   f"{r.signal} shows {p.aspect(r.signal)}", p)
+        p.do(f"cancel {r.signal}")
+        p.do(f"repair obstruction {t}")
+        p.do(f"throw {t} {pos}")
+        return p.until(lambda: p.state(r) == "released" and p.sim.turnout_state(t)[0] == pos, SETTLE_S)
+
+    def without_indication_on(self, p: Probe, t: str) -> bool:
+        """:meth:`without_indication`, then the route cancelled and the indication repaired."""
+        r = self.r
+        p.do(f"fault no-indication {t}")
+        open_route(p, r, timeout_s=SETTLE_S)
+        self.check(p.closed(r.signal), "no-indication", f"turnout {t} without indication: signal {r.signal} shows "
+                   f"{p.aspect(r.signal)}", p)
+        p.do(f"cancel {r.signal}")
+        p.do(f"repair no-indication {t}")
+        return p.until(lambda: p.state(r) == "released" and p.sim.turnout_state(t)[0] is not None, SETTLE_S)
+
+    def indication_lost_on(self, p: Probe, t: str) -> bool:
+        return self.closes_until_reopened(p, "no-indication", f"fault no-indication {t}",
+                                          f"turnout {t} lost its indication", f"repair no-indication {t}",
+                                          f"turnout {t}'s indication came back")
+
+    def occupied_refused_on(self, p: Probe, s: str) -> bool:
+        """:meth:`occupied_refused` without the wait: the refused route changed nothing; the section is cleared."""
+        r = self.r
+        p.do(f"occupy {s}")
+        result = p.do(route_line(r))
+        self.check(not result.ok and p.closed(r.signal), "section-occupied",
+                   f"section {s} occupied: '{route_line(r)}' was {'accepted' if result.ok else 'refused'} and "
+                   f"signal {r.signal} shows {p.aspect(r.signal)}", p)
+        p.do(f"vacate {s}")
+        return not result.ok and p.until(lambda: p.sim.section_state(s) != "occupied", SETTLE_S)
+
+    def occupied_closes_on(self, p: Probe, s: str) -> bool:
+        return self.closes_until_reopened(p, "section-occupied", f"occupy {s}", f"section {s} occupied",
+                                          f"vacate {s}", f"section {s} cleared")
 
     # ---- opening ------------------------------------------------------------------------------------------------
     def opens_from_the_other_positions(self) -> None:
@@ -198,36 +275,42 @@ class RouteTest(RouteCheck):
     def no_indication(self, t: str) -> None:
         """Without indication the signal cannot open; losing it closes the open signal, which stays closed after
         the repair until the operator reopens it (重复开放)."""
+        self.without_indication(t)
+        self.indication_lost(t)
+
+    def without_indication(self, t: str) -> None:
         r = self.r
         p = Probe(self.ctx)
         p.do(f"fault no-indication {t}")
         open_route(p, r, timeout_s=SETTLE_S)
         self.check(p.closed(r.signal), "no-indication", f"turnout {t} without indication: signal {r.signal} shows "
                    f"{p.aspect(r.signal)}", p)
+
+    def indication_lost(self, t: str) -> None:
         p = Probe(self.ctx)
         if not self.opened(p, "opens"):
             return
         self.closes_until_reopened(p, "no-indication", f"fault no-indication {t}", f"turnout {t} lost its indication",
                                    f"repair no-indication {t}", f"turnout {t}'s indication came back")
 
-    def closes_until_reopened(self, p: Probe, check: str, cause: str, what: str, repair: str, repaired: str) -> None:
+    def closes_until_reopened(self, p: Probe, check: str, cause: str, what: str, repair: str, repaired: str) -> bool:
         """On an open signal: ``cause`` closes it with an alarm; after ``repair`` it stays closed until the operator
-        reopens it (重复开放)."""
+        reopens it (重复开放). True when it was reopened."""
         sig = self.r.signal
         p.do(cause)
         p.run(1.0)
         if not self.check(p.closed(sig), check, f"{what}: signal {sig} still shows {p.aspect(sig)}", p):
-            return
+            return False
         self.closing_alarm(p)
         p.do(repair)
         p.run(5.0)
         if not self.check(p.closed(sig), "no-automatic-reopening", f"signal {sig} reopened by itself "
                           f"({p.aspect(sig)}) after {repaired}", p):
-            return
+            return False
         result = p.do(f"reopen {sig}")
         p.run(1.0)
-        self.check(result.ok and p.is_open(sig), "reopen", f"'reopen {sig}' after {repaired}: {result.message}; "
-                   f"signal shows {p.aspect(sig)}", p)
+        return self.check(result.ok and p.is_open(sig), "reopen", f"'reopen {sig}' after {repaired}: "
+                          f"{result.message}; signal shows {p.aspect(sig)}", p)
 
     def closing_alarm(self, p: Probe) -> None:
         """A signal closed abnormally raises an alarm (非正常关闭报警)."""
@@ -240,6 +323,10 @@ class RouteTest(RouteCheck):
     def section_occupied(self, s: str) -> None:
         """An occupied route, fouling or overlap section: the route cannot be set; occupied while open, the signal
         closes and stays closed after the section clears, until reopened."""
+        self.occupied_refused(s)
+        self.occupied_closes(s)
+
+    def occupied_refused(self, s: str) -> None:
         r = self.r
         p = Probe(self.ctx)
         p.do(f"occupy {s}")
@@ -249,6 +336,8 @@ class RouteTest(RouteCheck):
         self.check(not result.ok and p.closed(r.signal), "section-occupied",
                    f"section {s} occupied: '{route_line(r)}' was {'accepted' if result.ok else 'refused'} and "
                    f"signal {r.signal} shows {p.aspect(r.signal)}", p)
+
+    def occupied_closes(self, s: str) -> None:
         p = Probe(self.ctx)
         if not self.opened(p, "opens"):
             return
