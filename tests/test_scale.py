@@ -46,8 +46,8 @@ def test_the_plan_covers_the_table_with_batches_and_counts_every_pair() -> None:
     work = plan(table, None, pairs=True)
     routes = list(table.routes.values())
     assert work.pairs_tested == len(routes) * (len(routes) - 1) // 2
-    batches = [u for u in work.units if u.kind == "batch"]
-    proved = sorted(tuple(sorted(p)) for u in batches for p in u.pairs)
+    batches = [b for u in work.units if u.kind == "batches" for b in u.batches]
+    proved = sorted(tuple(sorted(p)) for _, pairs in batches for p in pairs)
     compatible = sorted(tuple(sorted((a.id, b.id))) for a, b in combinations(routes, 2)
                         if b.id not in a.conflicts and a.id not in b.conflicts and a.signal != b.signal
                         and b.id not in a.conditional and a.id not in b.conditional)

@@ -4,9 +4,10 @@ Enemies (:meth:`PairTest.rivals`): a route is set on a fresh simulation; every r
 be refused, both while it is still setting and once its signal is open (so each conflicting pair is tried both ways
 round). A refused command changes nothing and takes no time, so they are all tried on the one simulation.
 
-Compatible routes (:meth:`PairTest.batch`): a group of pairwise compatible routes (:func:`.plan.cover`) is set
-together on a fresh simulation; every signal open together proves every pair of the group. A group that does not all
-open is tried pair by pair, so a failure is replayed on a fresh simulation and its script shows just the two routes.
+Compatible routes (:meth:`PairTest.batches`): a group of pairwise compatible routes (:func:`.plan.cover`) is set
+together; every signal open together proves every pair of the group, and the group is cancelled before the next of
+its chain is set on the same simulation. A group that does not all open is tried pair by pair, so a failure is
+replayed on a fresh simulation and its script shows just the two routes.
 """
 
 from __future__ import annotations
@@ -24,15 +25,31 @@ class PairTest:
     def __init__(self, ctx: Context) -> None:
         self.ctx = ctx
 
-    def batch(self, routes: list[Route], pairs: list[tuple[Route, Route]]) -> None:
-        """``routes`` set together all open: each of ``pairs`` is proved; otherwise each pair is tried alone."""
-        p = Probe(self.ctx)
-        moves = len({t.id for r in routes for t in r.all_turnouts})
-        timeout = SETTLE_S + MOVE_S * (moves // self.ctx.rules.turnout_concurrency + 1)
-        if open_route(p, *routes, timeout_s=timeout):
+    def batches(self, chain: list[tuple[list[Route], list[tuple[Route, Route]]]]) -> None:
+        """Each batch of ``chain`` set together: all open proves each of its pairs, and the batch is cancelled before
+        the next is set on the same simulation. A batch that does not all open is tried pair by pair on fresh
+        simulations (and the next batch starts on a fresh one)."""
+        p: Probe | None = None
+        for routes, pairs in chain:
+            p = p or Probe(self.ctx)
+            moves = len({t.id for r in routes for t in r.all_turnouts})
+            timeout = SETTLE_S + MOVE_S * (moves // self.ctx.rules.turnout_concurrency + 1)
+            if not open_route(p, *routes, timeout_s=timeout):
+                self.one_by_one(pairs)
+                p = None
+                continue
             for a, b in pairs:
                 self.ctx.record(True, "compatible", f"{a.id} + {b.id}", "")
-            return
+            if not self._cancel_all(p, routes):
+                p = None
+
+    @staticmethod
+    def _cancel_all(p: Probe, routes: list[Route]) -> bool:
+        for r in routes:
+            p.do(f"cancel {r.signal}")
+        return p.until(lambda: all(p.state(r) == "released" for r in routes), SETTLE_S)
+
+    def one_by_one(self, pairs: list[tuple[Route, Route]]) -> None:
         for a, b in pairs:
             p = Probe(self.ctx)
             ok = open_route(p, a, b, timeout_s=SETTLE_S)

@@ -1,14 +1,16 @@
 """The interlocking test cut into units of work that run on their own simulations, in any order, on any worker.
 
-A :class:`Unit` is one route's items, one route's enemies (its rivals refused with it setting and open), one batch
-of mutually compatible routes set and open together, one conditionally conflicting pair, or one station-wide item.
+A :class:`Unit` is one route's items, one route's enemies (its rivals refused with it setting and open), a chain of
+batches of mutually compatible routes, each set and open together, one conditionally conflicting pair, or one
+station-wide item.
 :func:`plan` lists them in a fixed order for a station and a focus; the report is put together in that order,
 whatever ran where (:mod:`.spread`).
 
 Compatible pairs are proven in batches, not one at a time: :func:`cover` finds groups of routes that are pairwise
 compatible (cliques of the compatibility graph) until every compatible pair lies in one group. Setting a group's
 routes together and seeing every signal open proves each of its pairs; a group that does not open is tried again
-pair by pair, so a failure still comes with the script of just its two routes.
+pair by pair, so a failure still comes with the script of just its two routes. Batches run in chains on one
+simulation, each cancelled before the next is set: the turnouts the next needs often lie right already.
 """
 
 from __future__ import annotations
@@ -21,6 +23,7 @@ from liansuo.interlocking.table import InterlockingTable, Route
 from .probe import Failure
 
 MAX_BATCH = 40  # routes set together at most: their turnout moves queue (a few at a time), so time grows with it
+CHAIN = 32  # batches one after the other on one simulation (each cancelled before the next is set)
 _LOOK = 32  # candidates weighed for each place in a batch (more: fewer batches, longer planning)
 
 
@@ -33,16 +36,20 @@ def conditional(a: Route, b: Route) -> bool:
     return b.id in a.conditional or a.id in b.conditional
 
 
+Batch = tuple[tuple[str, ...], tuple[tuple[str, str], ...]]  # (routes set together, the pairs they prove)
+
+
 @dataclass(frozen=True)
 class Unit:
-    """One independent piece of the test. ``kind``: route, rivals, batch, conditional or station; ``routes``: the
-    routes it is about (a batch: all its routes); ``pairs``: the compatible pairs a batch proves (each pair is
-    proved by exactly one batch); ``item``: which station-wide item."""
+    """One independent piece of the test. ``kind``: route, rivals, batches, conditional or station; ``routes``: the
+    routes it is about; ``batches``: a chain of batches, each its routes and the compatible pairs it proves (each
+    pair is proved by exactly one batch); ``item``: which station-wide item."""
 
     kind: str
     routes: tuple[str, ...] = ()
-    pairs: tuple[tuple[str, str], ...] = ()
+    batches: tuple[Batch, ...] = ()
     item: str = ""
+
 
 
 @dataclass
@@ -99,10 +106,34 @@ def _pairs(order: list[Route], focus: set[str] | None) -> Plan:
             if (b.id in a.conflicts) != (a.id in b.conflicts) or (b.id in a.conditional) != (a.id in b.conditional):
                 out.asymmetric.append((a.id, b.id))
     ids = [r.id for r in order]
-    batches = [Unit("batch", tuple(ids[k] for k in group), tuple((ids[x], ids[y]) for x, y in proved))
-               for group, proved in cover(len(order), compatible)]
-    out.units = rivals + batches + conditionals
+    batches: list[Batch] = [(tuple(ids[k] for k in group), tuple((ids[x], ids[y]) for x, y in proved))
+                            for group, proved in cover(len(order), compatible)]
+    batches = by_turnouts(batches, {r.id: r for r in order})
+    chains = [Unit("batches", batches=tuple(batches[i:i + CHAIN])) for i in range(0, len(batches), CHAIN)]
+    out.units = rivals + chains + conditionals
     return out
+
+
+def by_turnouts(batches: list[Batch], routes: dict[str, Route], window: int = 32) -> list[Batch]:
+    """The batches in an order that moves few turnouts from one to the next of a chain (each chain starts with every
+    turnout normal): sorted by the turnouts they need reversed, then each next one the cheapest of the following
+    ``window``. Waiting for turnouts is most of a batch's time."""
+    def needs(b: Batch) -> dict[str, str]:
+        return {t.id: t.position.value for r in b[0] for t in routes[r].all_turnouts}
+
+    wanted = [needs(b) for b in batches]
+    left = sorted(range(len(batches)), key=lambda i: (sorted(t for t, p in wanted[i].items() if p == "reverse"), i))
+    out: list[int] = []
+    lie: dict[str, str] = {}
+    while left:
+        if len(out) % CHAIN == 0:
+            lie = {}
+        k = min(range(min(window, len(left))),
+                key=lambda j: (sum(lie.get(t, "normal") != p for t, p in wanted[left[j]].items()), j))
+        i = left.pop(k)
+        out.append(i)
+        lie.update(wanted[i])
+    return [batches[i] for i in out]
 
 
 def cover(n: int, edges: Iterable[tuple[int, int]], max_size: int = MAX_BATCH

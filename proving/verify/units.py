@@ -65,8 +65,9 @@ def run_unit(bench: Bench, unit: Unit, *, stop_at_first: bool = False) -> UnitRe
     elif unit.kind == "rivals":
         a, *rivals = (routes[r] for r in unit.routes)
         PairTest(ctx).rivals(a, rivals)
-    elif unit.kind == "batch":
-        PairTest(ctx).batch([routes[r] for r in unit.routes], [(routes[a], routes[b]) for a, b in unit.pairs])
+    elif unit.kind == "batches":
+        PairTest(ctx).batches([([routes[r] for r in group], [(routes[a], routes[b]) for a, b in pairs])
+                               for group, pairs in unit.batches])
     elif unit.kind == "conditional":
         PairTest(ctx).conditionally(routes[unit.routes[0]], routes[unit.routes[1]])
     elif unit.item == "throats":
