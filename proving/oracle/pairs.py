@@ -104,6 +104,33 @@ class PaperOracle:
             fouling += [s for s in f if s not in fouling]
         return auths, flank, fouling
 
+    # ---- what a route can touch -------------------------------------------------------------------------------------
+    def footprint(self, spec: RouteSpec) -> frozenset[str]:
+        """Every element the route's judgement against another route can turn on, over every way its free turnouts
+        lie: the turnouts it sets, runs over, needs for flank protection or lies against (with their crossover
+        partners), its sections, fouling sections and diamonds, the track it leads onto. Two routes whose footprints
+        are disjoint may be open together: :meth:`apart_when` finds a reason only in an element both touch (a
+        turnout set or needed both ways, a section, diamond or fouling section both hold, a track both lead onto),
+        and another route's turnouts change a route's authority only where that authority runs over them."""
+        fixed, _ = self.settle(spec)
+        turnouts = set(fixed)
+        elements: set[str] = set()
+        for _, (a,) in self.configurations(fixed, spec):
+            demands, fouling = self.flank.of(a.tracks, a.turnouts)
+            turnouts |= set(a.turnouts) | set(a.overlap_turnouts) | set(a.against) | set(demands)
+            if a.broken_at:
+                turnouts.add(a.broken_at)
+            elements |= {f"section {s}" for s in (*a.all_sections, *fouling)}
+            elements |= {f"diamond {d}" for d in a.diamonds}
+            if a.leads_into:
+                elements.add(f"section {a.leads_into}")  # head-on: its section, as the other's path names it
+            for secs, over, _ in self.tracer.overlaps.get(a.end_signal or "", ()) if a.kind == "train" else ():
+                elements |= {f"section {s}" for s in secs}  # every overlap: which one is taken turns on how
+                turnouts |= set(over)  # its turnouts lie, and another route may set them
+        for t in list(turnouts):
+            turnouts.update(self.partners.get(t, ()))
+        return frozenset(elements | {f"turnout {t}" for t in turnouts})
+
     # ---- two routes --------------------------------------------------------------------------------------------------
     def apart(self, x: RouteSpec, y: RouteSpec) -> str:
         """'' when ``x`` and ``y`` may be open together, else the first reason they may not."""

@@ -13,8 +13,6 @@ does.
 
 from __future__ import annotations
 
-from itertools import combinations
-
 from liansuo.interlocking.table import Route
 from liansuo.stations.schema import SectionRole, SignalKind
 
@@ -98,26 +96,35 @@ def approach_extent(ctx: Context) -> None:
 
 
 def pair_conflicts(ctx: Context, oracle: PaperOracle, focus: set[str] | None) -> tuple[int, int]:
-    """Every pair of routes from different signals; returns (pairs judged, pairs the oracle keeps apart)."""
+    """Every pair of routes from different signals; returns (pairs judged, pairs the oracle keeps apart). Pairs whose
+    footprints (:meth:`PaperOracle.footprint`) share nothing are judged compatible without tracing them together."""
     routes = list(ctx.table.routes.values())
     # the enemies the station file adds are the designer's word, not the oracle's to judge: the pair tests check that
     # the interlocking keeps them apart
     added = {frozenset((e.route, e.enemy)) for e in ctx.station.model.overrides.enemies}
+    prints = [oracle.footprint(spec(r)) for r in routes]
+    holders: dict[str, set[int]] = {}
+    for i, fp in enumerate(prints):
+        for element in fp:
+            holders.setdefault(element, set()).add(i)
     judged = apart = 0
-    for a, b in combinations(routes, 2):
-        if a.signal == b.signal or (focus and a.id not in focus and b.id not in focus):
-            continue
-        judged += 1
-        why, lies = oracle.apart_when(spec(a), spec(b))
-        listed = b.id in a.conflicts
-        when = [c for c, _ in a.conditional.get(b.id, ())]
-        if why:
-            apart += 1
-            covered = listed or any(all(lies.get(t) == p.value for t, p in c) for c in when)
-            ctx.record(covered, "omitted-conflict", f"{a.id} + {b.id}", f"{why}, but the table does not list "
-                       "them as conflicting" + (" for that" if when else ""))
-        elif frozenset((a.id, b.id)) not in added:
-            ctx.record(not listed and not when, "needless-conflict", f"{a.id} + {b.id}",
-                       f"the table lists them as conflicting ({a.conflicts.get(b.id) or 'conditionally'}), but the "
-                       "oracle finds nothing they share and no way they meet")
+    for i, a in enumerate(routes):
+        near = set().union(*(holders[e] for e in prints[i]))
+        for j in range(i + 1, len(routes)):
+            b = routes[j]
+            if a.signal == b.signal or (focus and a.id not in focus and b.id not in focus):
+                continue
+            judged += 1
+            why, lies = oracle.apart_when(spec(a), spec(b)) if j in near else ("", {})
+            listed = b.id in a.conflicts
+            when = [c for c, _ in a.conditional.get(b.id, ())]
+            if why:
+                apart += 1
+                covered = listed or any(all(lies.get(t) == p.value for t, p in c) for c in when)
+                ctx.record(covered, "omitted-conflict", f"{a.id} + {b.id}", f"{why}, but the table does not list "
+                           "them as conflicting" + (" for that" if when else ""))
+            elif frozenset((a.id, b.id)) not in added:
+                ctx.record(not listed and not when, "needless-conflict", f"{a.id} + {b.id}",
+                           f"the table lists them as conflicting ({a.conflicts.get(b.id) or 'conditionally'}), but "
+                           "the oracle finds nothing they share and no way they meet")
     return judged, apart
