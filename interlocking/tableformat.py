@@ -102,8 +102,8 @@ def as_json(table: InterlockingTable) -> str:
 
 
 def write_json(table: InterlockingTable, out: TextIO) -> None:
-    """The table's document (no newline after it), one route and one group at a time."""
-    signed = signed_table(table)
+    """The table's document (no newline after it), one route and one group at a time; the signed groups are derived
+    only once the routes are written (both at once would double the peak)."""
     out.write("{\n")
     _member(out, "station", table.station.id)
     out.write(',\n  "routes": ')
@@ -111,6 +111,7 @@ def write_json(table: InterlockingTable, out: TextIO) -> None:
     out.write(",\n")
     _member(out, "throats", {k: list(v) for k, v in table.throats.items()})
     out.write(",\n")
+    signed = signed_table(table)
     _member(out, "station_file", {"name": signed.file, "sha256": signed.sha256})
     out.write(',\n  "groups": ')
     _array(out, ({"name": g.name, "direction": g.direction, "category": g.category, "throat": g.throat,

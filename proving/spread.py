@@ -31,8 +31,9 @@ def client(workers: int, scheduler: str | None) -> Iterator[Any]:
         with Client(scheduler) as c:  # type: ignore[no-untyped-call]
             yield c
         return
+    # the dashboard on any free port; the workers' chatter when the cluster shuts down is silenced
     cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,  # type: ignore[no-untyped-call]
-                           dashboard_address=":0", silence_logs=logging.ERROR)  # any free port
+                           dashboard_address=":0", silence_logs=logging.CRITICAL)
     with cluster, Client(cluster) as c:  # type: ignore[no-untyped-call]
         yield c
 
