@@ -84,9 +84,9 @@ def verify_station(station: str | Path | Station, *, routes: list[str] | None = 
     table = bench.table
     ctx = bench.context(stop_at_first)
     focus = set(routes) if routes else None
-    work = plan(table, focus, pairs=pairs)
     results: list[UnitResult] = []
-    with frozen():
+    with frozen():  # before planning too: on a hub the plan makes millions of objects, the table is millions more
+        work = plan(table, focus, pairs=pairs)
         try:
             if focus:
                 for rid in sorted(focus - set(table.routes)):
