@@ -24,7 +24,7 @@ from liansuo.simulation.sim import Simulation
 from .oracle import Violation, Watch
 from .progress import progress
 from .soak import SoakRun, soak
-from .spread import fan_out
+from .spread import SpreadError, count, fan_out
 
 Add = Callable[..., argparse.ArgumentParser]
 MAX_REPRODUCERS = 5
@@ -155,6 +155,9 @@ def cmd_soak(args: argparse.Namespace) -> int:
         for d in exc.diagnostics:
             print(d, file=sys.stderr)
         return 1
+    except SpreadError as exc:
+        print(f"liansuo soak: {exc}", file=sys.stderr)
+        return 2
     elapsed = time.perf_counter() - t0
     found = 0
     for rep in reps:
@@ -207,9 +210,9 @@ def register(add: Add) -> None:
     sp.add_argument("--seed", type=int, default=1)
     sp.add_argument("--format", choices=("text", "json"), default="text")
     sp.add_argument("--out", metavar="DIR", help="also write each reproducer to DIR/soak-STATION-SEED-N.yaml")
-    sp.add_argument("--runs", type=int, default=0, metavar="K",
+    sp.add_argument("--runs", type=count, default=0, metavar="K",
                     help="independent runs, seeds SEED .. SEED+K-1 (default: one per worker)")
-    sp.add_argument("--workers", type=int, default=0, metavar="N",
+    sp.add_argument("--workers", type=count, default=0, metavar="N",
                     help="fan the runs out on Dask over N local worker processes (default: run here)")
     sp.add_argument("--scheduler", metavar="ADDRESS",
                     help="run on the Dask cluster whose scheduler is at ADDRESS (tcp://host:8786); docs/cluster.md")

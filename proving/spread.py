@@ -19,6 +19,24 @@ from .progress import Advance
 T = TypeVar("T")
 R = TypeVar("R")
 RETRIES = 2  # a task is tried again this many times (on another worker if its own died)
+CONNECT_S = 20  # how long to try to reach a scheduler
+
+
+class SpreadError(Exception):
+    """The cluster could not be reached or started: the message says what to do."""
+
+
+def count(text: str) -> int:
+    """``--workers`` / ``--runs``: a whole number, 0 or more (argparse type)."""
+    import argparse
+
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"{value} is negative; give 0 (run here) or more")
+    return value
 
 
 @contextmanager
@@ -28,7 +46,13 @@ def client(workers: int, scheduler: str | None) -> Iterator[Any]:
     from dask.distributed import Client, LocalCluster
 
     if scheduler:
-        with Client(scheduler) as c:  # type: ignore[no-untyped-call]
+        try:
+            c = Client(scheduler, timeout=CONNECT_S)  # type: ignore[no-untyped-call]
+        except (OSError, TimeoutError, ValueError) as exc:
+            raise SpreadError(f"cannot reach the Dask scheduler at {scheduler} ({exc}); start one with 'dask "
+                              "scheduler' and workers with 'dask worker ADDRESS' (docs/cluster.md), or leave out "
+                              "--scheduler to run here") from None
+        with c:
             yield c
         return
     # the dashboard on any free port; the workers' chatter when the cluster shuts down is silenced

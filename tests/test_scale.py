@@ -135,3 +135,25 @@ def test_routes_with_disjoint_footprints_are_never_kept_apart_by_the_oracle() ->
                 skipped += 1
                 assert oracle.apart(spec(a), spec(b)) == "", (station.id, a.id, b.id)
     assert skipped > 1000  # the filter does skip work
+
+
+def test_an_item_that_fails_on_the_shared_simulation_is_reported_with_its_own_script() -> None:
+    """A route's section items run in turn on one simulation; a failing one is run again alone, so its script holds
+    that one section only, as when every item had a fresh simulation."""
+    from liansuo.proving.mutants import MUTANTS
+
+    mutant = next(m for m in MUTANTS if m.name == "blind-to-occupancy")
+    with mutant.applied():
+        rep = verify_station("jiaopei", routes=["X-XI"], pairs=False)
+    failed = [f for f in rep.failures if f.check == "section-occupied"]
+    assert failed, [f.check for f in rep.failures]
+    for f in failed:
+        occupied = [s for s in f.steps if s.startswith("occupy ")]
+        assert len(occupied) == 1 and occupied[0].split()[1] in f.detail, f.steps
+
+
+def test_a_negative_number_of_workers_is_refused_with_a_reason() -> None:
+    done = subprocess.run([*LIANSUO, "verify", "jiaopei", "--workers", "-1"], capture_output=True, text=True)
+    assert done.returncode == 2 and "-1 is negative; give 0 (run here) or more" in done.stderr
+    done = subprocess.run([*LIANSUO, "soak", "jiaopei", "--runs", "two"], capture_output=True, text=True)
+    assert done.returncode == 2 and "'two' is not a whole number" in done.stderr

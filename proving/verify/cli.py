@@ -8,6 +8,8 @@ import json
 import sys
 from collections.abc import Callable
 
+from ..spread import SpreadError, count
+
 Add = Callable[..., argparse.ArgumentParser]
 
 
@@ -25,6 +27,9 @@ def cmd_verify(args: argparse.Namespace) -> int:
             print(d, file=sys.stderr)
         print(f"{len(exc.diagnostics)} error(s); the station was not loaded", file=sys.stderr)
         return 1
+    except SpreadError as exc:
+        print(f"liansuo verify: {exc}", file=sys.stderr)
+        return 2
     if args.format == "json":
         print(json.dumps(rep.as_dict(), ensure_ascii=False, indent=2))
     else:
@@ -40,7 +45,7 @@ def register(add: Add) -> None:
     sp.add_argument("--route", action="append", metavar="ID", help="test only this route and its pairs (repeatable)")
     sp.add_argument("--no-pairs", action="store_true", help="skip the pairs of routes")
     sp.add_argument("-v", "--verbose", action="store_true", help="print the steps that reproduce each failure")
-    sp.add_argument("--workers", type=int, default=0, metavar="N",
+    sp.add_argument("--workers", type=count, default=0, metavar="N",
                     help="fan the test out on Dask over N local worker processes (default: run here, in one)")
     sp.add_argument("--scheduler", metavar="ADDRESS",
                     help="run on the Dask cluster whose scheduler is at ADDRESS (tcp://host:8786); docs/cluster.md")

@@ -62,7 +62,7 @@ class RouteCheck:
             self.ctx, self.res = ctx, res
 
     def in_turn(self, items: Sequence[T], start: Callable[[], Probe | None], one: Callable[[Probe, T], bool],
-                alone: Callable[[T], None]) -> None:
+                alone: Callable[[T], object]) -> None:
         """The check of each item, one after the other on one simulation from ``start()`` (a refused command changes
         nothing; a signal reopened after a fault is as it was), while they pass: ``one(p, item)`` says whether the
         simulation is still as it was before the item. An item that fails there, or leaves it otherwise, is checked

@@ -32,9 +32,11 @@ class RouteTest(RouteCheck):
         self.in_turn(groups, self.fresh, self.obstructed_on, lambda g: self.turnout_obstructed(*g))
         turnouts = [rt.id for rt in self.r.all_turnouts]
         sections = list(self.r.all_sections)
-        self.in_turn(turnouts, self.fresh, self.without_indication_on, self.without_indication)
+        self.in_turn(turnouts, self.fresh, self.without_indication_on,
+                     lambda t: self.without_indication(Probe(self.ctx), t))
         self.in_turn(turnouts, self.open_probe, self.indication_lost_on, self.indication_lost)
-        self.in_turn(sections, self.fresh, self.occupied_refused_on, self.occupied_refused)
+        self.in_turn(sections, self.fresh, self.occupied_refused_on,
+                     lambda s: self.occupied_refused(Probe(self.ctx), s, wait=True))
         self.in_turn(sections, self.open_probe, self.occupied_closes_on, self.occupied_closes)
         ReleaseChecks(self).run()
         return self.res
@@ -50,47 +52,26 @@ class RouteTest(RouteCheck):
         return p if self.opened(p, "opens") else None
 
     def out_of_position_on(self, p: Probe, group: tuple[str, str]) -> bool:
-        """:meth:`turnout_out_of_position` without the wait: the refused route changed nothing. The turnout is
-        unlocked again after it (it may stay where it lies: the route moves it)."""
-        t, pos = group
-        r = self.r
-        p.do(f"throw {t} {other(pos)}")
-        if not p.until(lambda: p.sim.turnout_state(t)[0] == other(pos), SETTLE_S):
-            return False
-        p.do(f"lock {t}")
-        result = p.do(route_line(r))
-        self.check(not result.ok and p.closed(r.signal), "turnout-out-of-position",
-                   f"turnout {t} single-locked {other(pos)}: '{route_line(r)}' was "
-                   f"{'accepted' if result.ok else 'refused'} and signal {r.signal} shows {p.aspect(r.signal)}", p)
-        return not result.ok and p.do(f"unlock {t}").ok
+        """:meth:`out_of_position` without the wait (the refused route changed nothing), then the turnout unlocked
+        (it may stay where it lies: a route moves it)."""
+        return self.out_of_position(p, *group, wait=False) and p.do(f"unlock {group[0]}").ok
 
     def obstructed_on(self, p: Probe, group: tuple[str, str]) -> bool:
-        """:meth:`turnout_obstructed`, then the route cancelled and the obstruction cleared."""
+        """:meth:`obstructed`, then the route cancelled, the obstruction cleared and the turnout back."""
         t, pos = group
-        r = self.r
-        p.do(f"throw {t} {other(pos)}")
-        if not p.until(lambda: p.sim.turnout_state(t)[0] == other(pos), SETTLE_S):
+        if not self.obstructed(p, t, pos):
             return False
-        p.do(f"fault obstruction {t}")
-        p.do(route_line(r))
-        p.run(SETTLE_S)
-        self.check(p.closed(r.signal), "turnout-obstructed", f"turnout {t} obstructed on its way {pos}: signal "
-                   f"{r.signal} shows {p.aspect(r.signal)}", p)
-        p.do(f"cancel {r.signal}")
+        p.do(f"cancel {self.r.signal}")
         p.do(f"repair obstruction {t}")
         p.do(f"throw {t} {pos}")
-        return p.until(lambda: p.state(r) == "released" and p.sim.turnout_state(t)[0] == pos, SETTLE_S)
+        return p.until(lambda: p.state(self.r) == "released" and p.sim.turnout_state(t)[0] == pos, SETTLE_S)
 
     def without_indication_on(self, p: Probe, t: str) -> bool:
         """:meth:`without_indication`, then the route cancelled and the indication repaired."""
-        r = self.r
-        p.do(f"fault no-indication {t}")
-        open_route(p, r, timeout_s=SETTLE_S)
-        self.check(p.closed(r.signal), "no-indication", f"turnout {t} without indication: signal {r.signal} shows "
-                   f"{p.aspect(r.signal)}", p)
-        p.do(f"cancel {r.signal}")
+        self.without_indication(p, t)
+        p.do(f"cancel {self.r.signal}")
         p.do(f"repair no-indication {t}")
-        return p.until(lambda: p.state(r) == "released" and p.sim.turnout_state(t)[0] is not None, SETTLE_S)
+        return p.until(lambda: p.state(self.r) == "released" and p.sim.turnout_state(t)[0] is not None, SETTLE_S)
 
     def indication_lost_on(self, p: Probe, t: str) -> bool:
         return self.closes_until_reopened(p, "no-indication", f"fault no-indication {t}",
@@ -98,15 +79,10 @@ class RouteTest(RouteCheck):
                                           f"turnout {t}'s indication came back")
 
     def occupied_refused_on(self, p: Probe, s: str) -> bool:
-        """:meth:`occupied_refused` without the wait: the refused route changed nothing; the section is cleared."""
-        r = self.r
-        p.do(f"occupy {s}")
-        result = p.do(route_line(r))
-        self.check(not result.ok and p.closed(r.signal), "section-occupied",
-                   f"section {s} occupied: '{route_line(r)}' was {'accepted' if result.ok else 'refused'} and "
-                   f"signal {r.signal} shows {p.aspect(r.signal)}", p)
+        """:meth:`occupied_refused` without the wait (the refused route changed nothing), then the section cleared."""
+        refused = self.occupied_refused(p, s, wait=False)
         p.do(f"vacate {s}")
-        return not result.ok and p.until(lambda: p.sim.section_state(s) != "occupied", SETTLE_S)
+        return refused and p.until(lambda: p.sim.section_state(s) != "occupied", SETTLE_S)
 
     def occupied_closes_on(self, p: Probe, s: str) -> bool:
         return self.closes_until_reopened(p, "section-occupied", f"occupy {s}", f"section {s} occupied",
@@ -249,38 +225,46 @@ class RouteTest(RouteCheck):
 
     # ---- turnouts -----------------------------------------------------------------------------------------------
     def turnout_out_of_position(self, t: str, pos: str) -> None:
-        """A turnout lying the other way and single-locked there: the route cannot be set."""
-        r, p = self.r, Probe(self.ctx)
-        p.do(f"throw {t} {other(pos)}")
-        p.until(lambda: p.sim.turnout_state(t)[0] == other(pos), SETTLE_S)
+        self.out_of_position(Probe(self.ctx), t, pos, wait=True)
+
+    def out_of_position(self, p: Probe, t: str, pos: str, *, wait: bool) -> bool:
+        """A turnout lying the other way and single-locked there: the route cannot be set (``wait``: and its signal
+        stays closed for a while). True when the turnout lay the other way and the route was refused."""
+        r = self.r
+        laid = self.lay_other(p, t, pos)
         p.do(f"lock {t}")
         result = p.do(route_line(r))
-        p.run(SETTLE_S)
+        if wait:
+            p.run(SETTLE_S)
         self.check(not result.ok and p.closed(r.signal), "turnout-out-of-position",
                    f"turnout {t} single-locked {other(pos)}: '{route_line(r)}' was "
                    f"{'accepted' if result.ok else 'refused'} and signal {r.signal} shows {p.aspect(r.signal)}", p)
+        return laid and not result.ok
+
+    def lay_other(self, p: Probe, t: str, pos: str) -> bool:
+        """Throw ``t`` the other way from ``pos`` and wait until it lies there."""
+        p.do(f"throw {t} {other(pos)}")
+        return p.until(lambda: p.sim.turnout_state(t)[0] == other(pos), SETTLE_S)
 
     def turnout_obstructed(self, t: str, pos: str) -> None:
-        """A turnout that cannot reach its position (4 mm obstruction): the route stays unlocked, the signal closed."""
-        r, p = self.r, Probe(self.ctx)
-        p.do(f"throw {t} {other(pos)}")
-        p.until(lambda: p.sim.turnout_state(t)[0] == other(pos), SETTLE_S)
+        self.obstructed(Probe(self.ctx), t, pos)
+
+    def obstructed(self, p: Probe, t: str, pos: str) -> bool:
+        """A turnout that cannot reach its position (4 mm obstruction): the route stays unlocked, the signal closed.
+        True when the turnout lay the other way first and the signal stayed closed."""
+        r = self.r
+        laid = self.lay_other(p, t, pos)
         p.do(f"fault obstruction {t}")
         prepare(p, r)
         p.do(route_line(r))
         p.run(SETTLE_S)
-        self.check(p.closed(r.signal), "turnout-obstructed", f"turnout {t} obstructed on its way {pos}: signal "
-                   f"{r.signal} shows {p.aspect(r.signal)}", p)
+        return self.check(p.closed(r.signal), "turnout-obstructed", f"turnout {t} obstructed on its way {pos}: "
+                          f"signal {r.signal} shows {p.aspect(r.signal)}", p) and laid
 
-    def no_indication(self, t: str) -> None:
-        """Without indication the signal cannot open; losing it closes the open signal, which stays closed after
-        the repair until the operator reopens it (重复开放)."""
-        self.without_indication(t)
-        self.indication_lost(t)
-
-    def without_indication(self, t: str) -> None:
+    def without_indication(self, p: Probe, t: str) -> None:
+        """Without indication the signal cannot open (and losing it closes an open signal, which stays closed after
+        the repair until the operator reopens it (重复开放): :meth:`indication_lost`)."""
         r = self.r
-        p = Probe(self.ctx)
         p.do(f"fault no-indication {t}")
         open_route(p, r, timeout_s=SETTLE_S)
         self.check(p.closed(r.signal), "no-indication", f"turnout {t} without indication: signal {r.signal} shows "
@@ -290,8 +274,7 @@ class RouteTest(RouteCheck):
         p = Probe(self.ctx)
         if not self.opened(p, "opens"):
             return
-        self.closes_until_reopened(p, "no-indication", f"fault no-indication {t}", f"turnout {t} lost its indication",
-                                   f"repair no-indication {t}", f"turnout {t}'s indication came back")
+        self.indication_lost_on(p, t)
 
     def closes_until_reopened(self, p: Probe, check: str, cause: str, what: str, repair: str, repaired: str) -> bool:
         """On an open signal: ``cause`` closes it with an alarm; after ``repair`` it stays closed until the operator
@@ -320,26 +303,23 @@ class RouteTest(RouteCheck):
                    f"signal {sig} closed abnormally without an alarm (alarms: {'; '.join(alarms) or 'none'})", p)
 
     # ---- sections -----------------------------------------------------------------------------------------------
-    def section_occupied(self, s: str) -> None:
-        """An occupied route, fouling or overlap section: the route cannot be set; occupied while open, the signal
-        closes and stays closed after the section clears, until reopened."""
-        self.occupied_refused(s)
-        self.occupied_closes(s)
-
-    def occupied_refused(self, s: str) -> None:
+    def occupied_refused(self, p: Probe, s: str, *, wait: bool) -> bool:
+        """An occupied route, fouling or overlap section: the route is refused (``wait``: and its signal stays closed
+        for a while); occupied while open, the signal closes until reopened (:meth:`occupied_closes`). True when it
+        was refused."""
         r = self.r
-        p = Probe(self.ctx)
         p.do(f"occupy {s}")
         prepare(p, r)
         result = p.do(route_line(r))
-        p.run(SETTLE_S)
+        if wait:
+            p.run(SETTLE_S)
         self.check(not result.ok and p.closed(r.signal), "section-occupied",
                    f"section {s} occupied: '{route_line(r)}' was {'accepted' if result.ok else 'refused'} and "
                    f"signal {r.signal} shows {p.aspect(r.signal)}", p)
+        return not result.ok
 
     def occupied_closes(self, s: str) -> None:
         p = Probe(self.ctx)
         if not self.opened(p, "opens"):
             return
-        self.closes_until_reopened(p, "section-occupied", f"occupy {s}", f"section {s} occupied", f"vacate {s}",
-                                   f"section {s} cleared")
+        self.occupied_closes_on(p, s)
