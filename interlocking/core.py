@@ -11,6 +11,7 @@ inputs), not to the size of the station.
 from __future__ import annotations
 
 from collections import deque
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 from liansuo.rules import RuleSet, load_rules
@@ -86,6 +87,7 @@ class Core:
         self.platform_doors = {p.section: [f"{p.id}:{d.side.value}" for d in p.screen_doors]
                                for p in st.model.platforms if p.screen_doors}
         self._throat_platforms: dict[str, list[str]] = {}  # home signal -> platform tracks bordering its throat
+        self._door_sections: dict[str, tuple[str, ...]] = {}  # route id -> door_sections(route)
         self.autoblock = AutoBlock(st)
         self.codes_dirty = True
         self.blocks_dirty = False  # the automatic block signals must be evaluated again (a line's direction changed)
@@ -282,20 +284,22 @@ class Core:
             released = [s for i, s in enumerate(rs.sections) if rs.released[i]]
             return f"section {released[0]} of route {r.id} has been released: the route is no longer locked"
         own = len(rs.turnouts)  # the route's own turnouts come first and must be locked by it; the overlap's after
+        indication, held_by = self.board.indication, self.locks.held_by
         for i, t in enumerate(rs.all_turnouts):
-            ind = self.board.indication(t.id)
-            if ind != t.position.value:
+            ind = indication(t.id)
+            if ind != t.position:  # a StrEnum: equal to its value
                 what = "has no indication" if ind is None else f"is {ind}"
                 return f"turnout {t.id} {what}, the route needs it {t.position.value}"
-            if i < own and rs.id not in self.locks.holders(t.id):
+            if i < own and not held_by(t.id, rs.id):
                 return f"turnout {t.id} is not locked in route {r.id}"
         if not guide:
             skip = 0
             if not sections:
                 while skip < len(rs.sections) and not self.clear(rs.sections[skip]):
                     skip += 1
+            clear = self.board.clear
             for s in self.checked_sections(rs)[skip:]:
-                if not self.clear(s):
+                if not clear(s):
                     return f"section {s} is occupied"
         blocker = self.liaison_blocker(r)
         if blocker:
@@ -347,7 +351,7 @@ class Core:
         return (f"line {link} runs towards this station: change its direction for departures first (改方, "
                 f"'line-direction {link} out')")
 
-    def doors_blocker(self, sections: list[str]) -> str:
+    def doors_blocker(self, sections: Iterable[str]) -> str:
         """Why screen doors at these platform tracks keep a signal closed; '' when none does."""
         for sec in sections:
             for key in self.platform_doors.get(sec, ()):
@@ -379,14 +383,19 @@ class Core:
             self._throat_platforms[signal] = sorted(set(border))
         return self._throat_platforms[signal]
 
-    def door_sections(self, r: Route) -> list[str]:
+    def door_sections(self, r: Route) -> tuple[str, ...]:
+        """The platform tracks with screen doors the route runs over or starts from (the station's, so kept)."""
+        done = self._door_sections.get(r.id)
+        if done is not None:
+            return done
         out = [s for s in r.sections if s in self.platform_doors]
         rear = self.station.signal_rear_track(r.signal)
         if rear is not None:
             sec = self.station.tracks[rear].section
             if sec in self.platform_doors and sec not in out:
                 out.append(sec)
-        return out
+        self._door_sections[r.id] = tuple(out)
+        return self._door_sections[r.id]
 
     def _clear_blocks(self, link: str) -> int:
         """Clear block sections ahead of a departure, as many as the automatic block's aspects can tell apart."""

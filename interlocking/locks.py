@@ -24,6 +24,7 @@ class Hold(StrEnum):
 
 
 _LOCKS_TURNOUTS = frozenset({Hold.route, Hold.overlap, Hold.power_up})
+_HOLDS_ROUTES = frozenset({Hold.route, Hold.overlap})
 
 
 @dataclass(frozen=True)
@@ -125,8 +126,15 @@ class LockLedger:
         return out
 
     def turnout_locked(self, turnout: str) -> bool:
-        return bool(self._own_locks(turnout)) or (turnout in self.partner and bool(self._own_locks(
-            self.partner[turnout])))
+        """As ``bool(turnout_locks(turnout))``, without putting the locks in order."""
+        partner = self.partner.get(turnout)
+        return self._held(turnout) or (partner is not None and self._held(partner))
+
+    def _held(self, turnout: str) -> bool:
+        if self.turnouts.get(turnout):
+            return True
+        sec = self.turnout_section.get(turnout)
+        return sec is not None and any(lk.hold in _LOCKS_TURNOUTS for lk in self.sections.get(sec, ()))
 
     def why_turnout(self, turnout: str) -> str:
         """Why ``turnout`` may not move, in a signaller's words ('' when it may)."""
@@ -145,8 +153,15 @@ class LockLedger:
 
     def holders(self, turnout: str) -> set[str]:
         """Routes that hold ``turnout`` directly (by route or overlap lock)."""
-        return {lk.holder for lk in self.turnouts.get(turnout, ()) if lk.hold in (Hold.route, Hold.overlap)}
+        return {lk.holder for lk in self.turnouts.get(turnout, ()) if lk.hold in _HOLDS_ROUTES}
+
+    def held_by(self, turnout: str, route: str) -> bool:
+        """``route`` holds ``turnout`` directly (``route in holders(turnout)``)."""
+        return any(lk.holder == route and lk.hold in _HOLDS_ROUTES for lk in self.turnouts.get(turnout, ()))
+
+
+_RANK = {h: i for i, h in enumerate(Hold)}
 
 
 def _order(lk: Lock) -> tuple[int, str]:
-    return (list(Hold).index(lk.hold), lk.holder)
+    return (_RANK[lk.hold], lk.holder)

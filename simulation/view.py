@@ -175,6 +175,10 @@ class InterlockingView:
         return TurnoutView(turnout, il.board.indication(turnout), bool(locks),
                            il.locks.why_turnout(turnout) if locks else "", mark, turnout in il.core.moving)
 
+    def turnout_locked(self, turnout: str) -> bool:
+        """``turnout(turnout).locked`` alone: cheaper, for readers that ask it of many turnouts every cycle."""
+        return self._il.locks.turnout_locked(turnout)
+
     def turnouts(self) -> tuple[TurnoutView, ...]:
         """Every turnout, in station order."""
         return tuple(self.turnout(t) for t in self._il.core.turnouts)

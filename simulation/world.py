@@ -150,6 +150,10 @@ class World:
         tv = self.view.turnout(turnout)
         return tv.position, tv.locked
 
+    def turnout_locked(self, turnout: str) -> bool:
+        """``turnout_state(turnout)[1]``, asked alone (the safety oracle asks it of every turnout it watches)."""
+        return self.view.turnout_locked(turnout)
+
     def turnout_mark(self, turnout: str) -> str:
         """What the console marks on a turnout: 'blocked' (单封), 'locked' (单锁), 'guide' (引导总锁闭) or ''."""
         return self.view.turnout(turnout).mark

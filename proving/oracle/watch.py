@@ -105,7 +105,7 @@ class SimulationView:
         return self.field.track_up(section)
 
     def locked(self, turnout: str) -> bool:
-        return self.sim.turnout_state(turnout)[1]
+        return self.sim.turnout_locked(turnout)
 
     def wheelsets(self, tracks: set[str]) -> list[tuple[str, float]]:
         if self._wheelsets is None or self._wheelsets[0] != self.sim.t:
