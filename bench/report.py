@@ -11,6 +11,7 @@ from typing import Any
 
 from liansuo.interlocking.table import build_table
 from liansuo.proving.progress import Advance, progress
+from liansuo.stations.fit import fit_all
 from liansuo.stations.hubgen import generate_hub
 from liansuo.stations.loader import load_text
 
@@ -179,7 +180,7 @@ def as_text(report: dict[str, Any]) -> str:
         lines.append(f"  {t['station']:10} {t['figure']:16} {t['target']:>8}  measured {t['value']:g}  "
                      f"{'met' if t['met'] else 'MISSED'}")
     lines.append(f"total {report['total_s']:.1f} s")
-    return "\n".join(lines)
+    return fit_all(lines)
 
 
 def main(quick: bool = False, fmt: str = "json", scale: bool = False) -> int:

@@ -8,6 +8,7 @@ import csv
 from collections.abc import Sequence
 from typing import Any
 
+from liansuo.stations.fit import fit_all
 from liansuo.stations.station import Station
 
 COLUMNS = ("id", "carrier", "length_m", "capacitors", "adjustment_mV", "max_shunt_residual_mV",
@@ -109,7 +110,7 @@ def as_text(station: Station, rows: list[dict[str, Any]]) -> str:
     if any(r["relay"] != "up" for r in rows):
         lines.append(f"relay: marginal = under the {P.pickup_mV:g} mV pick-up (an up relay holds, a dropped one "
                      "stays down); down = red band")
-    return "\n".join(lines)
+    return fit_all(lines)
 
 
 def write_csv(path: str, rows: list[dict[str, Any]]) -> None:

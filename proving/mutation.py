@@ -18,6 +18,7 @@ from dataclasses import dataclass
 from importlib.resources import files
 from pathlib import Path
 
+from liansuo.stations.fit import fit_all
 from liansuo.stations.hubgen import generate_hub
 from liansuo.stations.library import bundled
 from liansuo.stations.loader import load, load_text
@@ -112,7 +113,7 @@ def report_text(results: list[Caught]) -> str:
         if r.by:
             lines.append(f"      {r.detail[:150]}")
     lines.append(f"score: {caught} of {len(results)} caught ({100 * caught / max(1, len(results)):.0f} %)")
-    return "\n".join(lines)
+    return fit_all(lines)
 
 
 def cmd_mutate(args: argparse.Namespace) -> int:

@@ -20,6 +20,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 from liansuo.simulation.sim import Simulation
+from liansuo.stations.fit import fit_all
 
 from .oracle import Violation, Watch
 from .progress import progress
@@ -200,7 +201,7 @@ def run_text(rep: dict[str, object]) -> str:
         if v["reproducer"]:
             lines.append("  reproducer:\n" + "\n".join(f"    {line}" for line in str(v["reproducer"]).splitlines()))
     lines.append(f"{len(violations)} violations")
-    return "\n".join(lines)
+    return fit_all(lines)
 
 
 def register(add: Add) -> None:

@@ -10,6 +10,7 @@ from itertools import pairwise
 
 import networkx as nx
 
+from .fit import metres, number
 from .schema import (
     Button,
     CircuitType,
@@ -135,7 +136,7 @@ class _Checker:
         pos = self.node_positions
         for i, tid, a, b in self._track_ports():
             if pos[a.node] == pos[b.node]:
-                self.err(("tracks", i), f"track '{tid}' has both ends at position {pos[a.node]:g} m",
+                self.err(("tracks", i), f"track '{tid}' has both ends at position {metres(pos[a.node])}",
                          "positions increase in the down direction; the two ends of a track must differ")
         if self.errors:
             return
@@ -147,7 +148,7 @@ class _Checker:
             side = {leg: other[(t.id, leg)] > t.at for leg in LEGS}
             if side["normal"] != side["reverse"]:
                 self.err(("turnouts", k, "at"),
-                         f"turnout {t.id}: its normal and reverse legs leave on opposite sides of {t.at:g} m",
+                         f"turnout {t.id}: its normal and reverse legs leave on opposite sides of {metres(t.at)}",
                          "both legs leave on the side away from the point; check the positions of their tracks")
             elif side["point"] == side["normal"]:
                 self.err(("turnouts", k, "at"),
@@ -161,11 +162,12 @@ class _Checker:
         for k, j in enumerate(self.m.joints):
             sides = {p > j.at for p in far_ends.get(j.id, [])}
             if len(sides) != 2:
-                self.err(("joints", k, "at"), f"joint '{j.id}': both its tracks leave on the same side of {j.at:g} m",
+                self.err(("joints", k, "at"), f"joint '{j.id}': both its tracks leave on the same side of "
+                                              f"{metres(j.at)}",
                          "a joint lies between its two tracks; check the positions")
             if j.at2 is not None and abs(j.at2 - j.at) > 30:
                 self.err(("joints", k, "at2"),
-                         f"joint '{j.id}': the two rail joints are {abs(j.at2 - j.at):g} m apart",
+                         f"joint '{j.id}': the two rail joints are {metres(abs(j.at2 - j.at))} apart",
                          "'at2' is the second rail's joint, normally within a few metres of 'at'")
 
     def sections(self) -> None:
@@ -383,8 +385,8 @@ class _Checker:
                 xb = self.node_positions[parse_port(t.end).node]
                 if not min(xa, xb) <= f.at <= max(xa, xb):
                     self.err(("fouling_points", k, "at"),
-                             f"fouling point {f.id} at {f.at:g} m is off track '{t.id}' "
-                             f"({min(xa, xb):g}-{max(xa, xb):g} m)",
+                             f"fouling point {f.id} at {metres(f.at)} is off track '{t.id}' "
+                             f"({number(min(xa, xb))}-{metres(max(xa, xb))})",
                              "a fouling point lies beside its tracks, between each track's two ends")
                     break
             else:
@@ -402,12 +404,13 @@ class _Checker:
         spans = sorted((g.start, g.end, k) for k, g in enumerate(self.m.profile))
         for g_start, g_end, k in spans:
             if g_end <= g_start:
-                self.err(("profile", k, "to"), f"profile stretch {k + 1} runs from {g_start:g} m to {g_end:g} m",
+                self.err(("profile", k, "to"), f"profile stretch {k + 1} runs from {metres(g_start)} to "
+                                               f"{metres(g_end)}",
                          "'to' is the higher position: write each stretch with from < to")
         for (a0, a1, ka), (b0, _, kb) in pairwise(spans):
             if b0 < a1 and a1 > a0:
-                self.err(("profile", kb, "from"), f"profile stretch {kb + 1} ({b0:g} m on) overlaps stretch {ka + 1} "
-                         f"(to {a1:g} m)", "give each part of the line one gradient")
+                self.err(("profile", kb, "from"), f"profile stretch {kb + 1} ({metres(b0)} on) overlaps stretch "
+                         f"{ka + 1} (to {metres(a1)})", "give each part of the line one gradient")
 
     def diamonds(self) -> None:
         tracks = {t.id: t for t in self.m.tracks}
@@ -437,12 +440,13 @@ class _Checker:
                 spans.append((min(xa, xb), max(xa, xb)))
             lo, hi = max(spans[0][0], spans[1][0]), min(spans[0][1], spans[1][1])
             if lo > hi:
-                self.err(("diamonds", k, "tracks"), f"diamond {d.id}: tracks {a.id} ({spans[0][0]:g}-"
-                         f"{spans[0][1]:g} m) and {b.id} ({spans[1][0]:g}-{spans[1][1]:g} m) do not overlap along "
-                         "the line, so they cannot cross", "name two tracks that pass the same point")
+                self.err(("diamonds", k, "tracks"), f"diamond {d.id}: tracks {a.id} ({number(spans[0][0])}-"
+                         f"{metres(spans[0][1])}) and {b.id} ({number(spans[1][0])}-{metres(spans[1][1])}) do not "
+                         "overlap along the line, so they cannot cross", "name two tracks that pass the same point")
             elif d.at is not None and not lo <= d.at <= hi:
-                self.err(("diamonds", k, "at"), f"diamond {d.id} at {d.at:g} m is not on both tracks (they run "
-                         f"side by side from {lo:g} to {hi:g} m)", "give the point where the two tracks cross")
+                self.err(("diamonds", k, "at"), f"diamond {d.id} at {metres(d.at)} is not on both tracks (they run "
+                         f"side by side from {number(lo)} to {metres(hi)})", "give the point where the two tracks "
+                         "cross")
 
     def markers(self) -> None:
         tracks = {t.id: t for t in self.m.tracks}
@@ -455,8 +459,9 @@ class _Checker:
             xa = self.node_positions[parse_port(t.start).node]
             xb = self.node_positions[parse_port(t.end).node]
             if not min(xa, xb) <= mk.at <= max(xa, xb):
-                self.err(("markers", k, "at"), f"marker {mk.id} at {mk.at:g} m is off track '{t.id}' "
-                         f"({min(xa, xb):g}-{max(xa, xb):g} m)", "a marker lies on its track, between its two ends")
+                self.err(("markers", k, "at"), f"marker {mk.id} at {metres(mk.at)} is off track '{t.id}' "
+                         f"({number(min(xa, xb))}-{metres(max(xa, xb))})", "a marker lies on its track, between its "
+                         "two ends")
 
     def platforms(self) -> None:
         sections = {s.id: s for s in self.m.sections}

@@ -8,6 +8,7 @@ import json
 import sys
 from collections.abc import Callable
 
+from .fit import fit
 from .library import bundled, describe
 from .loader import load
 from .schema import StationFile
@@ -28,7 +29,7 @@ def print_errors(exc: StationError) -> int:
 
 def cmd_stations(args: argparse.Namespace) -> int:
     for name, path in bundled().items():
-        print(f"{name:10} {describe(path)}")
+        print(fit(f"{name:10} {describe(path)}", indent=" " * 11))
     return 0
 
 

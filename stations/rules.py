@@ -9,6 +9,7 @@ from itertools import pairwise
 
 from liansuo.rules import DesignRules, load_rules
 
+from .fit import metres
 from .schema import CircuitType, Direction, FoulingPoint, JointKind, SignalKind
 from .source import Diagnostic, Loc
 from .station import Station
@@ -63,19 +64,21 @@ class _Warner:
             j = self.st.joints[dz.joint]
             if j.kind is JointKind.electrical:
                 if dz.length > self.r.tuning_dead_zone_max_m:
-                    self.warn(self.loc("joints", j.id), f"dead zone of {dz.length:.2f} m in tuning area '{j.id}' "
-                              f"exceeds {self.r.tuning_dead_zone_max_m:g} m", "check the tuning-unit positions")
+                    self.warn(self.loc("joints", j.id), f"dead zone of {metres(dz.length)} in tuning area '{j.id}' "
+                              f"exceeds {metres(self.r.tuning_dead_zone_max_m)}", "check the tuning-unit positions")
                 continue
             limit = self.r.joint_stagger_max_turnout_m if self._at_turnout_section(j.id) else self.r.joint_stagger_max_m
             if dz.length > limit:
                 self.warn(self.loc("joints", j.id, "at2"),
-                          f"joint '{j.id}': rail joints staggered {dz.length:.2f} m (limit {limit:g} m); the dead zone "
-                          "can hide a wheelset", "move one rail's joint to bring the stagger within the limit")
+                          f"joint '{j.id}': rail joints staggered {metres(dz.length)} (limit {metres(limit)}); the "
+                          "dead zone can hide a wheelset",
+                          "move one rail's joint to bring the stagger within the limit")
             if dz.length >= self.r.bogie_wheelbase_min_m:
                 self.warn(self.loc("joints", j.id, "at2"),
-                          f"joint '{j.id}': the {dz.length:.2f} m dead zone can hold a whole bogie (wheelbase from "
-                          f"{self.r.bogie_wheelbase_min_m:g} m): its wheelsets there shunt nothing, so a vehicle can "
-                          "vanish from the interlocking", "shorten the dead zone below the shortest bogie wheelbase")
+                          f"joint '{j.id}': the {metres(dz.length)} dead zone can hold a whole bogie (wheelbase from "
+                          f"{metres(self.r.bogie_wheelbase_min_m)}): its wheelsets there shunt nothing, so a "
+                          "vehicle can vanish from the interlocking",
+                          "shorten the dead zone below the shortest bogie wheelbase")
 
     def spacing(self) -> None:
         zones = {dz.joint: dz for dz in self.st.dead_zones}
@@ -95,10 +98,10 @@ class _Warner:
                         and zb.length < self.r.dead_zone_short_m):
                     continue
                 self.warn(self.loc("joints", b, "at"),
-                          f"section '{sec}': dead zones at joints '{a}' and '{b}' are only {gap:.1f} m apart "
-                          f"(need >= {self.r.dead_zone_spacing_min_m:g} m, or >= "
-                          f"{self.r.dead_zone_spacing_relaxed_m:g} m when both are under "
-                          f"{self.r.dead_zone_short_m:g} m)",
+                          f"section '{sec}': dead zones at joints '{a}' and '{b}' are only {metres(gap)} apart "
+                          f"(need >= {metres(self.r.dead_zone_spacing_min_m)}, or >= "
+                          f"{metres(self.r.dead_zone_spacing_relaxed_m)} when both are under "
+                          f"{metres(self.r.dead_zone_short_m)})",
                           "a short vehicle could stand in both dead zones at once and vanish from the interlocking")
 
     def _tracks_near(self, joint: str, reach: float) -> set[str]:
@@ -153,8 +156,10 @@ class _Warner:
         if d >= clearance:
             return
         self.warn(self.loc("fouling_points", fp, "at"),
-                  f"fouling point {fp} is {d:.1f} m ahead of the joint of starting signal {sig} (need >= "
-                  f"{clearance:g} m)" + (" : the joint is inside the fouling limit" if d < 0 else ""),
+                  (f"fouling point {fp} is {metres(d)} ahead of the joint of starting signal {sig} (need >= "
+                   f"{metres(clearance)})" if d >= 0 else
+                   f"the joint of starting signal {sig} lies inside the fouling limit: fouling point {fp} is "
+                   f"{metres(-d)} behind it (need >= {metres(clearance)} ahead)"),
                   "a train stopped at the signal could foul the throat; move the joint or the signal back")
 
     def coding(self) -> None:
@@ -170,9 +175,9 @@ class _Warner:
             need = min_coded_length(v, self.r)
             have = self.st.section_span(s.id)
             if have < need:
-                self.warn(self.loc("sections", s.id), f"coded section '{s.id}' is {have:.1f} m long; at {v:g} km/h "
-                          f"({why}) the cab signal needs >= {need:.2f} m ({self.r.cab_code_min_time_s:g} s * v + "
-                          f"{self.r.cab_code_margin_m:g} m)", "lengthen the section, or give it the 'speed_kmh' "
+                self.warn(self.loc("sections", s.id), f"coded section '{s.id}' is {metres(have)} long; at {v:g} km/h "
+                          f"({why}) the cab signal needs >= {metres(need)} ({self.r.cab_code_min_time_s:g} s * v + "
+                          f"{metres(self.r.cab_code_margin_m)})", "lengthen the section, or give it the 'speed_kmh' "
                           "trains really pass it at")
 
     def _coding_speed(self, section: str, own: float | None, main: set[str]) -> tuple[float, str]:
@@ -224,21 +229,22 @@ class _Warner:
             if j.kind is JointKind.electrical:
                 ta = j.tuning_area_m or self.r.tuning_area_m
                 if abs(ta - self.r.tuning_area_m) > self.r.tuning_area_tolerance_m:
-                    self.warn(self.loc("joints", j.id, "tuning_area_m"), f"tuning area of joint '{j.id}' is {ta:g} m "
-                              f"(standard {self.r.tuning_area_m:g} m, tolerance {self.r.tuning_area_tolerance_m:g} m)",
+                    self.warn(self.loc("joints", j.id, "tuning_area_m"), f"tuning area of joint '{j.id}' is "
+                              f"{metres(ta)} (standard {metres(self.r.tuning_area_m)}, tolerance "
+                              f"{metres(self.r.tuning_area_tolerance_m)})",
                               "check the positions of the two tuning units")
 
     def lengths(self) -> None:
         for s in self.st.model.sections:
             length = self.st.section_length(s.id)
             if s.type is CircuitType.phase25hz and length > self.r.phase25hz_max_length_m:
-                self.warn(self.loc("sections", s.id), f"25 Hz section '{s.id}' is {length:.0f} m long "
-                          f"(limit about {self.r.phase25hz_max_length_m:g} m)", "split it with an insulated joint")
+                self.warn(self.loc("sections", s.id), f"25 Hz section '{s.id}' is {metres(length)} long "
+                          f"(limit about {metres(self.r.phase25hz_max_length_m)})", "split it with an insulated joint")
             run = self.st.section_span(s.id)  # the track circuit's main run, not its branches added to it
             if (s.type is CircuitType.zpw2000a and run > self.r.capacitor_min_section_m
                     and (s.capacitors is None or s.capacitors.count == 0)):
-                self.warn(self.loc("sections", s.id), f"ZPW-2000A section '{s.id}' is {run:.0f} m long but has no "
-                          f"compensation capacitors (needed over {self.r.capacitor_min_section_m:g} m)",
+                self.warn(self.loc("sections", s.id), f"ZPW-2000A section '{s.id}' is {metres(run)} long but has no "
+                          f"compensation capacitors (needed over {metres(self.r.capacitor_min_section_m)})",
                           "add 'capacitors: {rule: standard}'")
 
 

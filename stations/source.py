@@ -9,6 +9,8 @@ from typing import Any
 
 import yaml
 
+from .fit import fit
+
 try:  # the C loader is much faster where libyaml is present
     from yaml import CSafeLoader as _Loader
 except ImportError:  # pragma: no cover - depends on how PyYAML was built
@@ -37,9 +39,14 @@ class Diagnostic:
     severity: str = "error"
 
     def __str__(self) -> str:
-        text = f"{self.file}:{self.line}:{self.column}: {self.severity}: {self.message}"
+        return self.text()
+
+    def text(self, lead: str = "") -> str:
+        """The diagnostic as the command line prints it, each line starting with ``lead``, folded to fit a
+        terminal."""
+        text = fit(f"{lead}{self.file}:{self.line}:{self.column}: {self.severity}: {self.message}", keep=3)
         if self.hint:
-            text += f"\n    hint: {self.hint}"
+            text += "\n" + fit(f"{lead}    hint: {self.hint}")
         return text
 
     def as_dict(self) -> dict[str, Any]:

@@ -5,6 +5,7 @@ from __future__ import annotations
 from collections import Counter
 from typing import Any
 
+from .fit import fit_all, metres, number
 from .station import Station
 
 
@@ -35,7 +36,7 @@ def summary_text(station: Station) -> str:
     s = summarise(station)
     lines = [
         f"{s['station']}: {s['name']['zh']} ({s['name']['en']})  [{s['file']}]",
-        f"  tracks       {s['tracks']} ({s['track_length_m']:g} m of track)",
+        f"  tracks       {s['tracks']} ({metres(s['track_length_m'])} of track)",
         f"  turnouts     {s['turnouts']}" + (f" (crossover pairs {', '.join(s['crossover_pairs'])})"
                                              if s["crossover_pairs"] else ""),
         *([f"  double slips {', '.join(s['double_slips'])}"] if s["double_slips"] else []),
@@ -45,7 +46,8 @@ def summary_text(station: Station) -> str:
         "  links        " + (", ".join(f"{lk['id']} ({lk['kind']} to {lk['neighbour']})" for lk in s["links"]) or "-"),
         f"  dead zones   {len(s['dead_zones'])}",
     ]
-    lines += [f"    {d['joint']}: {d['from_m']:g}-{d['to_m']:g} m, {d['length_m']:g} m" for d in s["dead_zones"]]
+    lines += [f"    {d['joint']}: {number(d['from_m'])}-{metres(d['to_m'])}, {metres(d['length_m'])}"
+              for d in s["dead_zones"]]
     lines.append(f"  warnings     {len(station.warnings)}")
-    lines += [f"  {w}" for w in station.warnings]
-    return "\n".join(lines)
+    lines += [w.text("  ") for w in station.warnings]
+    return fit_all(lines)

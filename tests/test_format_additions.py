@@ -223,7 +223,7 @@ def test_the_fouling_rule_measures_a_tied_point_along_the_turnout_legs() -> None
     near = edit(base, ("{id: FP1, track: t-1b, at: 290}", '{id: FP1, turnout: "1", tracks: [t-1b, t-1c], at: 298}'))
     warnings = load_text(near, "w.yaml").warnings
     assert [w.message for w in warnings] == [
-        "fouling point FP1 is 2.0 m ahead of the joint of starting signal SI (need >= 3.5 m)"]
+        "fouling point FP1 is 2 m ahead of the joint of starting signal SI (need >= 3.5 m)"]
     far = edit(near, ("at: 298}", "at: 296}"))
     assert load_text(far, "w.yaml").warnings == []
 
@@ -261,7 +261,7 @@ def test_a_coded_main_line_section_is_measured_at_line_speed() -> None:
     fast = edit(MINIMAL, ("line_speed_kmh: 80", "line_speed_kmh: 160"), ("{id: 1DG, type: 25hz}",
                                                                           "{id: 1DG, type: 25hz, coded: true}"))
     [w] = load_text(fast, "c.yaml").warnings
-    assert "coded section '1DG' is 110.0 m long; at 160 km/h (line speed on the main line)" in w.message
+    assert "coded section '1DG' is 110 m long; at 160 km/h (line speed on the main line)" in w.message
     assert load_text(edit(fast, ("line_speed_kmh: 160", "line_speed_kmh: 80")), "c.yaml").warnings == []
 
 

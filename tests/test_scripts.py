@@ -51,5 +51,5 @@ def test_malformed_script_gives_file_and_line(tmp_path: Path, capsys: pytest.Cap
     f = tmp_path / "bad.yaml"
     f.write_text("station: jiaopei\ntests:\n  - name: x\n    steps:\n      - rout X XI\n", encoding="utf-8")
     assert main(["test", str(f)]) == 1
-    err = capsys.readouterr().err
+    err = " ".join(capsys.readouterr().err.split())  # as read across folded lines
     assert f"{f}:5:9: error: unknown command 'rout'" in err and "Traceback" not in err

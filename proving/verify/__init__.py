@@ -14,6 +14,7 @@ from pathlib import Path
 
 from liansuo.interlocking.table import InterlockingTable
 from liansuo.rules import RuleSet, load_rules
+from liansuo.stations.fit import fit_all, plural
 from liansuo.stations.loader import load
 from liansuo.stations.station import Station
 
@@ -139,6 +140,7 @@ def report_text(rep: VerifyReport, *, verbose: bool = False) -> str:
     if rep.failures and not verbose and any(f.steps for f in rep.failures):
         lines.append("(-v prints the steps that reproduce each failure; --format json includes them)")
     verdict = "PASS" if rep.ok else "FAIL"
-    lines.append(f"{verdict}: {rep.checks} checks, {len(rep.failures)} failures, {len(rep.warnings)} warnings "
-                 f"({rep.routes_tested} routes, {rep.pairs_tested} pairs) in {rep.elapsed_s:.1f} s")
-    return "\n".join(lines)
+    lines.append(f"{verdict}: {plural(rep.checks, 'check')}, {plural(len(rep.failures), 'failure')}, "
+                 f"{plural(len(rep.warnings), 'warning')} ({plural(rep.routes_tested, 'route')}, "
+                 f"{plural(rep.pairs_tested, 'pair')}) in {rep.elapsed_s:.1f} s")
+    return fit_all(lines)
