@@ -154,13 +154,16 @@ def read_yaml(text: str, file: str) -> Source:
     return src
 
 
-def read_file(path: Path, missing_hint: str = "give a bundled station name (see 'liansuo stations') or a path"
-              ) -> Source:
+def read_text(path: Path, missing_hint: str = "give a bundled station name (see 'liansuo stations') or a path"
+              ) -> str:
+    """The file's text; :class:`StationError` at ``FILE:1:1`` when it is missing or unreadable."""
     try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise StationError([Diagnostic(str(path), 1, 1, "no such file", missing_hint)]) from None
+        return path.read_text(encoding="utf-8")
+    except (FileNotFoundError, NotADirectoryError):
+        raise StationError([Diagnostic(str(path), 1, 1, f"no such file; {missing_hint}")]) from None
+    except IsADirectoryError:
+        raise StationError([Diagnostic(str(path), 1, 1, f"this is a folder, not a file; {missing_hint}")]) from None
     except (OSError, UnicodeDecodeError) as exc:
         raise StationError([Diagnostic(str(path), 1, 1, f"cannot read the file: {exc}",
-                                       "station files are UTF-8 text")]) from None
-    return read_yaml(text, str(path))
+                                       "liansuo's files are UTF-8 text")]) from None
+
