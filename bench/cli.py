@@ -17,6 +17,6 @@ def cmd_bench(args: argparse.Namespace) -> int:
 def register(add: Add) -> None:
     sp = add("bench", cmd_bench, "benchmark table building and the interlocking cycle (hub and jiaopei)")
     sp.add_argument("--quick", action="store_true", help="fewer cycles (under a minute)")
-    sp.add_argument("--format", choices=("json", "text"), default="json")
+    sp.add_argument("--format", choices=("json", "text"), default="json", help="json (default) or text")
     sp.add_argument("--scale", action="store_true", help="also verify, soak and write the table of large hubs "
                     "(hours in full; with --quick minutes): docs/benchmark.md")

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import csv
 from collections.abc import Sequence
-from typing import Any
+from typing import Any, TextIO
 
 from liansuo.stations.fit import fit_all
 from liansuo.stations.station import Station
@@ -113,9 +113,9 @@ def as_text(station: Station, rows: list[dict[str, Any]]) -> str:
     return fit_all(lines)
 
 
-def write_csv(path: str, rows: list[dict[str, Any]]) -> None:
-    with open(path, "w", newline="", encoding="utf-8") as f:
-        writer = csv.DictWriter(f, fieldnames=COLUMNS, extrasaction="ignore")
-        writer.writeheader()
-        for r in rows:
-            writer.writerow({**r, "fault": r["fault"] or ""})
+def write_csv(out: TextIO, rows: list[dict[str, Any]]) -> None:
+    """The rows as CSV, one line a section, the columns of :data:`COLUMNS`."""
+    writer = csv.DictWriter(out, fieldnames=COLUMNS, extrasaction="ignore")
+    writer.writeheader()
+    for r in rows:
+        writer.writerow({**r, "fault": r["fault"] or ""})

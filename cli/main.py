@@ -8,6 +8,7 @@ loads the console (Textual) and the console never slows the other subcommands.
 from __future__ import annotations
 
 import argparse
+import sys
 from collections.abc import Callable, Sequence
 
 from liansuo.bench import cli as bench
@@ -58,6 +59,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     handler: Handler | None = getattr(args, "handler", None)
     if handler is None:
         parser.print_help()
+        print("liansuo: a COMMAND is needed (the list above)", file=sys.stderr)
         return 2
     try:
         return handler(args)

@@ -10,7 +10,8 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import TextIO
 
-from liansuo.stations.cli import print_errors
+from liansuo.stations.arguments import unwritable
+from liansuo.stations.exitcodes import Exit, bad_input, refuse
 from liansuo.stations.loader import load
 from liansuo.stations.source import StationError
 
@@ -28,15 +29,15 @@ def cmd_table(args: argparse.Namespace) -> int:
         print(json.dumps(TABLE_SCHEMA, ensure_ascii=False, indent=2))
         return 0
     if args.station is None:
-        print("liansuo table: a STATION is needed (or --schema)", file=sys.stderr)
-        return 2
+        return refuse("table", "a STATION is needed (or --schema)", Exit.USAGE)
     if args.format == "xlsx" and args.output is None:
-        print("liansuo table: --format xlsx needs -o FILE", file=sys.stderr)
-        return 2
+        return refuse("table", "--format xlsx needs -o FILE", Exit.USAGE)
+    if args.output is not None and (why := unwritable(Path(args.output))):
+        return refuse("table", why, Exit.USAGE)
     try:
         table = build_table(load(args.station))
     except StationError as exc:
-        return print_errors(exc)
+        return bad_input(exc)
     if args.format == "xlsx":
         from .tablexlsx import write_xlsx
 
@@ -74,9 +75,8 @@ def _write(path: Path, write: Callable[[Path], object]) -> int:
         tmp.replace(path)
     except OSError as exc:
         tmp.unlink(missing_ok=True)
-        print(f"liansuo table: cannot write {path}: {exc.strerror or exc}; give -o a file in a folder you can write "
-              "to", file=sys.stderr)
-        return 1
+        return refuse("table", f"cannot write {path}: {exc.strerror or exc}; give -o a file in a folder you can "
+                      "write to", Exit.USAGE)
     print(f"wrote {path}")
     return 0
 
@@ -84,6 +84,7 @@ def _write(path: Path, write: Callable[[Path], object]) -> int:
 def register(add: Add) -> None:
     sp = add("table", cmd_table, "print the interlocking table (联锁表) derived from the topology")
     sp.add_argument("station", nargs="?", help="bundled station name or path")
-    sp.add_argument("--format", choices=("text", "csv", "json", "xlsx"), default="text")
-    sp.add_argument("-o", "--output", help="write to FILE (needed for xlsx)")
+    sp.add_argument("--format", choices=("text", "csv", "json", "xlsx"), default="text",
+                    help="text (default), csv, json or xlsx (xlsx needs -o)")
+    sp.add_argument("-o", "--output", metavar="FILE", help="write to FILE instead of stdout (needed for xlsx)")
     sp.add_argument("--schema", action="store_true", help="print the JSON Schema of --format json and exit")

@@ -1,7 +1,9 @@
 """The interlocking table as text (the signed layout, at most 120 columns), CSV and JSON.
 
 Text and CSV print the cells of :mod:`.signedtable`, so they agree with each other and with the xlsx export
-(:mod:`.tablexlsx`); JSON is the table's data (``InterlockingTable.as_dict``) with the signed groups added.
+(:mod:`.tablexlsx`); JSON is the table's data (``InterlockingTable.as_dict``) with the signed groups added, after
+the envelope every liansuo JSON report starts with (``liansuo``, ``schema``, ``ok``; see
+:mod:`liansuo.stations.jsonreport`).
 
 CSV and JSON are written row by row (:func:`write_csv`, :func:`write_json`): a hub's table lists hundreds of
 thousands of conflicting pairs, and holding its whole JSON document (and then its text) at once took most of a
@@ -15,6 +17,8 @@ import io
 import json
 from collections.abc import Iterator
 from typing import TextIO
+
+from liansuo.stations.jsonreport import envelope
 
 from .signedtable import COLUMNS, SignedTable, cell_width, signed_table
 from .table import InterlockingTable
@@ -105,6 +109,9 @@ def write_json(table: InterlockingTable, out: TextIO) -> None:
     """The table's document (no newline after it), one route and one group at a time; the signed groups are derived
     only once the routes are written (both at once would double the peak)."""
     out.write("{\n")
+    for key, value in envelope("table", True).items():  # which liansuo wrote it, and the shape's version
+        _member(out, key, value)
+        out.write(",\n")
     _member(out, "station", table.station.id)
     out.write(',\n  "routes": ')
     _array(out, (r.as_dict() for r in table.routes.values()), bool(table.routes))

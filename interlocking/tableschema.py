@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from typing import Any
 
+from liansuo.stations.jsonreport import SCHEMAS
+
 from .signedtable import COLUMNS
 
 _STR = {"type": "string"}
@@ -59,8 +61,11 @@ TABLE_SCHEMA: dict[str, Any] = {
     "title": "liansuo interlocking table (联锁表)",
     "type": "object",
     "additionalProperties": False,
-    "required": ["station", "routes", "throats", "station_file", "groups"],
+    "required": ["liansuo", "schema", "ok", "station", "routes", "throats", "station_file", "groups"],
     "properties": {
+        "liansuo": {"type": "string", "description": "the version of liansuo that wrote the table"},
+        "schema": {"const": SCHEMAS["table"], "description": "the version of this JSON shape"},
+        "ok": {"const": True},
         "station": _STR,
         "routes": {"type": "array", "items": _ROUTE},
         "throats": {"type": "object", "additionalProperties": _STRS},

@@ -1,37 +1,80 @@
-"""``liansuo test FILE... [-k TEXT] [-v] [--junit-xml FILE]``: run YAML route-test scripts;
-``liansuo run SCENARIO [--until DURATION] [--engine kinematic|sumo]``: run a scenario headless."""
+"""``liansuo test FILE... [-k TEXT] [-v] [--format text|json] [--junit-xml FILE]``: run YAML route-test scripts;
+``liansuo run SCENARIO [--until DURATION] [--engine kinematic|sumo] [--format text|json]``: run a scenario headless.
+
+Every file is read and every station loaded before anything runs, so a bad input stops the command with exit
+status 3 and nothing run or written (docs/commands.md, "Exit status").
+"""
 
 from __future__ import annotations
 
 import argparse
-import sys
 from collections.abc import Callable
 from pathlib import Path
 
 from liansuo.simulation.timeparse import parse_duration
 from liansuo.simulation.trains.sumo import SumoEngineError
 from liansuo.simulation.trains.sumo_export import SumoExportError, SumoUnavailable
-from liansuo.stations.cli import print_errors
+from liansuo.stations.arguments import unwritable
+from liansuo.stations.exitcodes import Exit, bad_input, refuse
+from liansuo.stations.jsonreport import print_report
 from liansuo.stations.source import StationError
+from liansuo.stations.station import Station
 
 from .junit import write_junit
-from .scenario import parse_scenario, run_scenario
-from .scripts import Outcome, parse_script, run_script
+from .scenario import ScenarioLog, parse_scenario, run_scenario, station_of
+from .scripts import Outcome, Script, parse_script, run_script, script_station, selected
 
 Add = Callable[..., argparse.ArgumentParser]
+FORMATS = ("text", "json")
+
+
+def _load_scripts(files: list[str]) -> list[tuple[Script, Station]] | int:
+    """Every script with its station, or the exit status of the first that did not load (all are reported)."""
+    scripts: list[tuple[Script, Station]] = []
+    status = 0
+    for f in files:
+        try:
+            script = parse_script(Path(f))
+        except StationError as exc:
+            status = bad_input(exc, "test script")
+            continue
+        try:
+            scripts.append((script, script_station(script)))
+        except StationError as exc:
+            status = bad_input(exc, f"station of {f}")
+    return status or scripts
 
 
 def cmd_test(args: argparse.Namespace) -> int:
+    if args.junit_xml and (why := unwritable(Path(args.junit_xml), "--junit-xml")):
+        return refuse("test", why, Exit.USAGE)
+    loaded = _load_scripts(args.files)
+    if isinstance(loaded, int):
+        return loaded
+    if not any(selected(script, args.k) for script, _ in loaded):
+        total = sum(len(script.tests) for script, _ in loaded)
+        return refuse("test", f"no test name contains {args.k!r} (of {total} test{'s' if total != 1 else ''} in "
+                      f"{len(loaded)} script{'s' if len(loaded) != 1 else ''}); nothing ran", Exit.NOTHING_SELECTED)
     outcomes: list[Outcome] = []
-    broken = 0
-    for f in args.files:
-        try:
-            script = parse_script(Path(f))
-            outcomes += run_script(script, args.k)
-        except StationError as exc:
-            for d in exc.diagnostics:
-                print(d, file=sys.stderr)
-            broken += 1
+    for script, station in loaded:
+        outcomes += run_script(script, args.k, station)
+    passed = sum(o.passed for o in outcomes)
+    failed = len(outcomes) - passed
+    if args.format == "json":
+        print_report("test", failed == 0, {"scripts": list(args.files), "k": args.k, "passed": passed,
+                                           "failed": failed, "tests": [o.as_dict() for o in outcomes]})
+    else:
+        _print_outcomes(outcomes, args.verbose)
+        print(f"{passed} passed, {failed} failed")
+    if args.junit_xml:
+        write_junit(args.junit_xml, outcomes)
+    if failed:
+        return refuse("test", f"{failed} of {len(outcomes)} test{'s' if len(outcomes) != 1 else ''} failed",
+                      Exit.FAILED)
+    return 0
+
+
+def _print_outcomes(outcomes: list[Outcome], verbose: bool) -> None:
     for o in outcomes:
         if o.passed:
             print(f"PASS {o.script}: {o.name}")
@@ -39,38 +82,43 @@ def cmd_test(args: argparse.Namespace) -> int:
                 print(f"    HAZARD {h}")
         else:
             print(f"FAIL {o.script}:{o.line}: {o.name}\n    {o.failure}")
-            if args.verbose:
+            if verbose:
                 for entry in o.log:
                     print(f"      {entry}")
-    if args.junit_xml:
-        write_junit(args.junit_xml, outcomes)
-    passed = sum(o.passed for o in outcomes)
-    failed = len(outcomes) - passed + broken
-    print(f"{passed} passed, {failed} failed")
-    return 0 if failed == 0 and outcomes else 1
 
 
 def cmd_run(args: argparse.Namespace) -> int:
-    try:
-        sc = parse_scenario(Path(args.scenario))
-    except StationError as exc:
-        return print_errors(exc)
     until = None
     if args.until:
         try:
             until = parse_duration(args.until)
         except ValueError as exc:
-            print(f"--until: {exc}", file=sys.stderr)
-            return 2
+            return refuse("run", f"--until {args.until}: {exc}", Exit.USAGE)
     try:
-        status, sim = run_scenario(sc, until, engine=args.engine)
+        sc = parse_scenario(Path(args.scenario))
     except StationError as exc:
-        return print_errors(exc)
+        return bad_input(exc, "scenario")
+    try:
+        station = station_of(sc)
+    except StationError as exc:
+        return bad_input(exc, f"station of {args.scenario}")
+    log = ScenarioLog()
+    text: list[str] | None = [] if args.format == "json" else None  # the text log is not printed with JSON
+    try:
+        status, sim = run_scenario(sc, until, text, engine=args.engine, log=log, station=station)
     except (SumoUnavailable, SumoExportError, SumoEngineError) as exc:  # the SUMO engine could not start
-        print(f"liansuo run --engine {args.engine}: {exc}", file=sys.stderr)
-        return 2
+        return refuse(f"run --engine {args.engine}", str(exc), Exit.USAGE)
     sim.close()
-    return status
+    if args.format == "json":
+        print_report("run", status == 0, {"scenario": sc.file, "station": sc.station, "engine": args.engine,
+                                          "events": log.events, "problems": log.problems,
+                                          "end_s": log.end_s, "trains": log.trains})
+    if status:
+        first = log.problems[0] if log.problems else None
+        where = f"{sc.file}:{first['line']}: '{first['command']}'" if first else sc.file
+        verdict = "was refused; the run stopped" if first and first["refused"] else "did not hold"
+        return refuse("run", f"{where} {verdict}", Exit.FAILED)
+    return 0
 
 
 def register_run(add: Add) -> None:
@@ -80,11 +128,13 @@ def register_run(add: Add) -> None:
     sp.add_argument("--engine", choices=("kinematic", "sumo"), default="kinematic",
                     help="what moves the trains: the built-in kinematic model (default) or Eclipse SUMO "
                          "(pip install 'liansuo[sumo]'; see docs/sumo.md)")
+    sp.add_argument("--format", choices=FORMATS, default="text", help="text (default: the event log) or json")
 
 
 def register(add: Add) -> None:
     sp = add("test", cmd_test, "run YAML route-test scripts")
-    sp.add_argument("files", nargs="+", help="test script files")
-    sp.add_argument("-k", metavar="TEXT", help="run only tests whose name contains TEXT")
+    sp.add_argument("files", nargs="+", metavar="FILE", help="test script files")
+    sp.add_argument("-k", metavar="TEXT", help="run only tests whose name contains TEXT (exit status 5 if none does)")
     sp.add_argument("-v", "--verbose", action="store_true", help="print every step of failing tests")
+    sp.add_argument("--format", choices=FORMATS, default="text", help="text (default) or json")
     sp.add_argument("--junit-xml", metavar="FILE", help="also write a JUnit XML report")

@@ -8,7 +8,6 @@ is caught when either finds anything. The score is the share caught.
 from __future__ import annotations
 
 import argparse
-import json
 import multiprocessing
 import os
 import time
@@ -18,10 +17,14 @@ from dataclasses import dataclass
 from importlib.resources import files
 from pathlib import Path
 
+from liansuo.stations.arguments import positive_int
+from liansuo.stations.exitcodes import Exit, bad_input, refuse
 from liansuo.stations.fit import fit_all
 from liansuo.stations.hubgen import generate_hub
+from liansuo.stations.jsonreport import print_report
 from liansuo.stations.library import bundled
 from liansuo.stations.loader import load, load_text
+from liansuo.stations.source import StationError
 from liansuo.stations.station import Station
 
 from .mutants import MUTANTS, Mutant
@@ -117,25 +120,45 @@ def report_text(results: list[Caught]) -> str:
 
 
 def cmd_mutate(args: argparse.Namespace) -> int:
+    unknown = sorted(set(args.mutant or ()) - {m.name for m in MUTANTS})
+    if unknown:
+        return refuse("mutate", f"no mutant {', '.join(unknown)}; 'liansuo mutate --list' names them", Exit.USAGE)
+    if args.list:
+        for m in MUTANTS:
+            print(f"{m.name:34} {m.what}")
+        return 0
+    for spec in args.station or ():  # every station loads before any mutant runs
+        try:
+            load_station(spec)
+        except StationError as exc:
+            return bad_input(exc)
+        except ValueError:
+            return refuse("mutate", f"--station {spec}: a generated hub is hub:TURNOUTS:TRACKS", Exit.USAGE)
     chosen = [m for m in MUTANTS if not args.mutant or m.name in args.mutant]
     t0 = time.perf_counter()
     results = run_mutants(args.station or None, chosen, args.soak_steps)
     caught = sum(bool(r.by) for r in results)
     if args.format == "json":
-        print(json.dumps({"mutants": len(results), "caught": caught, "score": round(caught / max(1, len(results)), 3),
-                          "elapsed_s": round(time.perf_counter() - t0, 1),
-                          "results": [r.as_dict() for r in results]}, ensure_ascii=False, indent=2))
+        print_report("mutate", caught == len(results), {
+            "mutants": len(results), "caught": caught, "score": round(caught / max(1, len(results)), 3),
+            "elapsed_s": round(time.perf_counter() - t0, 1), "results": [r.as_dict() for r in results]})
     else:
         print(report_text(results))
-    return 0 if caught == len(results) else 1
+    if caught < len(results):
+        missed = [r.mutant for r in results if not r.by]
+        return refuse("mutate", f"{len(missed)} seeded defect{'s' if len(missed) != 1 else ''} not caught: "
+                      f"{', '.join(missed)}", Exit.FAILED)
+    return 0
 
 
 def register(add: Add) -> None:
     sp = add("mutate", cmd_mutate, "seed defects into the interlocking and show that verify and the oracle catch them")
     sp.add_argument("--station", action="append", metavar="STATION",
                     help="station to run on (repeatable; default: the bundled and example stations)")
-    sp.add_argument("--mutant", action="append", metavar="NAME", help="only this mutant (repeatable)")
-    sp.add_argument("--soak-steps", type=int, default=SOAK_STEPS,
+    sp.add_argument("--mutant", action="append", metavar="NAME",
+                    help="only this mutant (repeatable; --list names them)")
+    sp.add_argument("--list", action="store_true", help="list the mutants and exit")
+    sp.add_argument("--soak-steps", type=positive_int, default=SOAK_STEPS, metavar="N",
                     help=f"random steps per station for a mutant verify misses (default {SOAK_STEPS})")
-    sp.add_argument("--format", choices=("text", "json"), default="text")
+    sp.add_argument("--format", choices=("text", "json"), default="text", help="text (default) or json")
     sp.set_defaults(handler=cmd_mutate)

@@ -15,13 +15,16 @@ interlocking and of the world is printed as the run goes.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 from liansuo.simulation.sim import LANGUAGE, Simulation
 from liansuo.simulation.timeparse import parse_duration
+from liansuo.stations.filekind import read_source
 from liansuo.stations.loader import load
-from liansuo.stations.source import Diagnostic, StationError, read_file
+from liansuo.stations.source import Diagnostic, StationError
+from liansuo.stations.station import Station
 
 
 @dataclass
@@ -34,7 +37,7 @@ class Scenario:
 
 
 def parse_scenario(path: Path) -> Scenario:
-    src = read_file(path, "give the path of a scenario file (see examples/scenarios/)")
+    src = read_source(path, "scenario", "give the path of a scenario file (see examples/scenarios/)")
     data = src.data
     errors: list[Diagnostic] = []
     if not isinstance(data, dict):
@@ -64,16 +67,37 @@ def parse_scenario(path: Path) -> Scenario:
     return Scenario(str(path), str(data["station"]), str(data.get("description", "")), steps, until)
 
 
-def run_scenario(sc: Scenario, until_s: float | None = None, out: list[str] | None = None,
-                 engine: str = "kinematic") -> tuple[int, Simulation]:
-    """Run the scenario; returns (exit status, the simulation). Lines of the event log go to ``out`` (or stdout).
-    ``engine``: the train engine, "kinematic" or "sumo" (see :class:`Simulation`)."""
+@dataclass
+class ScenarioLog:
+    """What a run showed, as ``liansuo run --format json`` writes it: the events in time order, the steps that were
+    refused or whose expectation failed, and the trains at the end."""
+
+    events: list[dict[str, Any]] = field(default_factory=list)  # {t, kind, text}
+    problems: list[dict[str, Any]] = field(default_factory=list)  # {line, command, refused, message}
+    end_s: float = 0.0
+    trains: list[dict[str, Any]] = field(default_factory=list)  # {name, sections, speed_kmh}
+
+
+def station_of(sc: Scenario) -> Station:
+    """The scenario's station: a bundled name, or a path as given or relative to the scenario's folder."""
     try:
-        station = load(sc.station)
+        return load(sc.station)
     except StationError:
-        station = load(Path(sc.file).parent / sc.station)
-    sim = Simulation(station, engine=engine)
+        candidate = Path(sc.file).parent / sc.station
+        if candidate.exists():
+            return load(candidate)
+        raise
+
+
+def run_scenario(sc: Scenario, until_s: float | None = None, out: list[str] | None = None,
+                 engine: str = "kinematic", log: ScenarioLog | None = None,
+                 station: Station | None = None) -> tuple[int, Simulation]:
+    """Run the scenario; returns (exit status, the simulation). Lines of the event log go to ``out`` (or stdout),
+    and the same as data to ``log`` when one is given. ``engine``: the train engine, "kinematic" or "sumo" (see
+    :class:`Simulation`); ``station``: the scenario's station when already loaded."""
+    sim = Simulation(station or station_of(sc), engine=engine)
     seen = [0, 0]  # events already printed from the interlocking and from the world
+    log = log if log is not None else ScenarioLog()
 
     def emit(text: str) -> None:
         if out is None:
@@ -86,17 +110,28 @@ def run_scenario(sc: Scenario, until_s: float | None = None, out: list[str] | No
         new = sorted(il_events[seen[0]:] + world[seen[1]:], key=lambda e: e.t)
         seen[0], seen[1] = len(il_events), len(world)
         for e in new:
+            log.events.append({"t": round(e.t, 2), "kind": e.kind, "text": e.text})
             emit(f"{e.t:9.2f} {e.kind:8} {e.text}")
+
+    def problem(command: str, line: int, refused: bool, message: str) -> None:
+        log.problems.append({"line": line, "command": command, "refused": refused, "message": message})
+        emit(f"{sc.file}:{line}: '{command}'{' refused' if refused else ''}: {message}")
+
+    def finish(status: int) -> tuple[int, Simulation]:
+        log.end_s = round(sim.t, 2)
+        log.trains = [{"name": v.name, "sections": list(v.sections), "speed_kmh": v.speed_kmh}
+                      for v in sim.train_views()]
+        return status, sim
 
     status = 0
     for command, line in sc.steps:
         result = sim.command(command)
         flush()
         if not result.ok and not command.strip().startswith("expect"):
-            emit(f"{sc.file}:{line}: '{command}' refused: {result.message}")
-            return 1, sim
+            problem(command, line, True, result.message)
+            return finish(1)  # a refused command stops the run
         if command.strip().startswith("expect") and not result.ok:
-            emit(f"{sc.file}:{line}: '{command}': {result.message}")
+            problem(command, line, False, result.message)
             status = 1
     end = until_s if until_s is not None else sc.until_s
     while end is not None and sim.t < end:
@@ -105,4 +140,4 @@ def run_scenario(sc: Scenario, until_s: float | None = None, out: list[str] | No
     emit(f"-- end of scenario at t = {sim.t:g} s; trains: "
          + (", ".join(f"{v.name} in {' '.join(v.sections) or 'nothing'} at {v.speed_kmh:g} km/h"
                       for v in sim.train_views()) or "none"))
-    return status, sim
+    return finish(status)

@@ -24,8 +24,9 @@ from pathlib import Path
 
 from liansuo.interlocking.io import Result
 from liansuo.simulation.sim import LANGUAGE, Simulation
+from liansuo.stations.filekind import read_source
 from liansuo.stations.loader import load
-from liansuo.stations.source import Diagnostic, StationError, read_file
+from liansuo.stations.source import Diagnostic, StationError
 from liansuo.stations.station import Station
 
 from .oracle import Watch
@@ -63,9 +64,14 @@ class Outcome:
     log: list[str] = field(default_factory=list)
     hazards: list[str] = field(default_factory=list)  # what the oracle found that the interlocking cannot see
 
+    def as_dict(self) -> dict[str, object]:
+        """The outcome as ``liansuo test --format json`` lists it (docs/commands.md)."""
+        return {"script": self.script, "name": self.name, "passed": self.passed, "line": self.line or None,
+                "failure": self.failure or None, "hazards": self.hazards, "log": [] if self.passed else self.log}
+
 
 def parse_script(path: Path) -> Script:
-    src = read_file(path, "give the path of a YAML test script (see examples/scripts/)")
+    src = read_source(path, "script", "give the path of a YAML test script (see examples/scripts/)")
     errors: list[Diagnostic] = []
     data = src.data
     if not isinstance(data, dict):
@@ -116,15 +122,25 @@ def _resolve_station(script: Script, src_dir: Path) -> Station:
         raise
 
 
-def run_script(script: Script, only: str | None = None) -> list[Outcome]:
-    station = _resolve_station(script, Path(script.file).parent)
+def script_station(script: Script) -> Station:
+    """The station the script runs on: a bundled name, or a path as given or relative to the script's folder;
+    :class:`StationError` when it does not load."""
+    return _resolve_station(script, Path(script.file).parent)
+
+
+def selected(script: Script, only: str | None) -> list[ScriptTest]:
+    """The script's tests whose name contains ``only`` (case-insensitive); all of them without it."""
+    return [t for t in script.tests if not only or only.lower() in t.name.lower()]
+
+
+def run_script(script: Script, only: str | None = None, station: Station | None = None) -> list[Outcome]:
+    """Run the tests ``only`` selects, each on a fresh simulation of the script's station (loaded unless given)."""
+    station = station or script_station(script)
     from liansuo.interlocking.table import build_table
 
     table = build_table(station)
     outcomes = []
-    for test in script.tests:
-        if only and only.lower() not in test.name.lower():
-            continue
+    for test in selected(script, only):
         outcomes.append(run_test(script, test, station, table))
     return outcomes
 

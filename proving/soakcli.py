@@ -13,14 +13,15 @@ does (within a budget of replays).
 from __future__ import annotations
 
 import argparse
-import json
-import sys
 import time
 from collections.abc import Callable
 from pathlib import Path
 
 from liansuo.simulation.sim import Simulation
+from liansuo.stations.arguments import positive_int
+from liansuo.stations.exitcodes import Exit, bad_input, refuse
 from liansuo.stations.fit import fit_all
+from liansuo.stations.jsonreport import print_report
 
 from .oracle import Violation, Watch
 from .progress import progress
@@ -153,12 +154,9 @@ def cmd_soak(args: argparse.Namespace) -> int:
         reps = soak_runs(args.station, args.steps, seeds, workers=workers, scheduler=args.scheduler,
                          show_progress=None)
     except StationError as exc:
-        for d in exc.diagnostics:
-            print(d, file=sys.stderr)
-        return 1
+        return bad_input(exc)
     except SpreadError as exc:
-        print(f"liansuo soak: {exc}", file=sys.stderr)
-        return 2
+        return refuse("soak", str(exc), Exit.USAGE)
     elapsed = time.perf_counter() - t0
     found = 0
     for rep in reps:
@@ -172,19 +170,22 @@ def cmd_soak(args: argparse.Namespace) -> int:
                                                                                     encoding="utf-8")
     if args.format == "json":
         if len(reps) == 1 and not workers:
-            print(json.dumps(reps[0], ensure_ascii=False, indent=2))
+            print_report("soak", not found, reps[0])
         else:
             steps = sum(int(str(r["steps"])) for r in reps)
-            print(json.dumps({"station": reps[0]["station"], "runs": reps, "workers": workers, "steps": steps,
-                              "elapsed_s": round(elapsed, 2), "steps_per_s": round(steps / elapsed, 1),
-                              "violations": found}, ensure_ascii=False, indent=2))
+            print_report("soak", not found, {"station": reps[0]["station"], "runs": reps, "workers": workers,
+                                             "steps": steps, "elapsed_s": round(elapsed, 2),
+                                             "steps_per_s": round(steps / elapsed, 1), "violations": found})
     else:
         for rep in reps:
             print(run_text(rep))
         if len(reps) > 1:
             print(f"{len(reps)} runs (seeds {seeds[0]}..{seeds[-1]}) on {workers or 1} worker(s) in {elapsed:.1f} s: "
                   f"{found} violations")
-    return 1 if found else 0
+    if found:
+        return refuse("soak", f"{found} safety violation{'s' if found != 1 else ''} (the reproducers are in the "
+                      "report)", Exit.FAILED)
+    return 0
 
 
 def run_text(rep: dict[str, object]) -> str:
@@ -207,9 +208,10 @@ def run_text(rep: dict[str, object]) -> str:
 def register(add: Add) -> None:
     sp = add("soak", cmd_soak, "random operation under the safety oracle; a reproducer script per violation")
     sp.add_argument("station", help="bundled station name or path to a station YAML file")
-    sp.add_argument("--steps", type=int, default=10_000, help="random steps (default 10000)")
-    sp.add_argument("--seed", type=int, default=1)
-    sp.add_argument("--format", choices=("text", "json"), default="text")
+    sp.add_argument("--steps", type=positive_int, default=10_000, metavar="N", help="random steps (default 10000)")
+    sp.add_argument("--seed", type=int, default=1, metavar="S",
+                    help="seed of the random choices (default 1): the same seed gives the same run")
+    sp.add_argument("--format", choices=("text", "json"), default="text", help="text (default) or json")
     sp.add_argument("--out", metavar="DIR", help="also write each reproducer to DIR/soak-STATION-SEED-N.yaml")
     sp.add_argument("--runs", type=count, default=0, metavar="K",
                     help="independent runs, seeds SEED .. SEED+K-1 (default: one per worker)")

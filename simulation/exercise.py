@@ -21,8 +21,9 @@ from dataclasses import dataclass, field
 from importlib.resources import files
 from pathlib import Path
 
+from liansuo.stations.filekind import read_source
 from liansuo.stations.library import bundled
-from liansuo.stations.source import Diagnostic, StationError, read_file
+from liansuo.stations.source import Diagnostic, StationError
 
 from .sim import LANGUAGE, Simulation
 
@@ -60,7 +61,7 @@ def parse_exercise(path: str | Path) -> Exercise:
     if not given.exists():
         given = next((p for p in bundled_exercises() if p.stem == str(path)), given)
     names = ", ".join(p.stem for p in bundled_exercises())
-    src = read_file(given, f"give the path of an exercise file, or a bundled exercise: {names}")
+    src = read_source(given, "exercise", f"give the path of an exercise file, or a bundled exercise: {names}")
     data = src.data
     errors: list[Diagnostic] = []
     if not isinstance(data, dict):

@@ -23,10 +23,12 @@ from pathlib import Path
 from typing import IO, Any
 
 from liansuo.interlocking.io import Result
+from liansuo.stations.filekind import RECORDING_FORMAT, kind_of_data, kind_of_text, wrong_kind
+from liansuo.stations.source import StationError, read_yaml
 
 from .sim import Simulation
 
-FORMAT = "liansuo-recording"
+FORMAT = RECORDING_FORMAT
 VERSION = 1
 
 Record = dict[str, Any]
@@ -187,12 +189,23 @@ class RecordingError(ValueError):
 
 
 def load_recording(path: str | Path) -> Recording:
-    """Read a recording; :class:`RecordingError` names the line of anything malformed."""
+    """Read a recording; :class:`RecordingError` names the line of anything malformed, and the kind of a file that
+    is another kind of liansuo file (a station, a script ...)."""
     p = Path(path)
     try:
-        lines = p.read_text(encoding="utf-8").splitlines()
-    except OSError as exc:
-        raise RecordingError(f"{p}: {exc.strerror or exc}") from exc
+        whole = p.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise RecordingError(f"{p}:1: no such file; give a recording written by 'liansuo tui --record FILE'") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise RecordingError(f"{p}:1: cannot read the file: {exc}") from exc
+    if kind_of_text(whole) != "recording":
+        try:
+            found = kind_of_data(read_yaml(whole, str(p)).data)
+        except StationError:
+            found = None
+        if found is not None:
+            raise RecordingError(str(wrong_kind(str(p), found, "recording").diagnostics[0]))
+    lines = whole.splitlines()
     records: list[Record] = []
     for i, text in enumerate(lines, 1):
         if not text.strip():

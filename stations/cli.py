@@ -1,5 +1,5 @@
-"""``liansuo stations``, ``liansuo check STATION [--format text|json]``, ``liansuo schema`` and ``liansuo generate hub
---turnouts N --tracks M [-o FILE]``: the station files."""
+"""``liansuo stations [--format text|json]``, ``liansuo check STATION [--format text|json]``, ``liansuo schema`` and
+``liansuo generate hub --turnouts N --tracks M [-o FILE]``: the station files."""
 
 from __future__ import annotations
 
@@ -8,7 +8,10 @@ import json
 import sys
 from collections.abc import Callable
 
+from .arguments import positive_int, unwritable
+from .exitcodes import Exit, bad_input, refuse
 from .fit import fit
+from .jsonreport import print_report
 from .library import bundled, describe
 from .loader import load
 from .schema import StationFile
@@ -16,18 +19,14 @@ from .source import StationError
 from .summary import summarise, summary_text
 
 Add = Callable[..., argparse.ArgumentParser]
-
-
-def print_errors(exc: StationError) -> int:
-    """Every diagnostic of a station that did not load, on stderr; the exit status 1."""
-    for d in exc.diagnostics:
-        print(d, file=sys.stderr)
-    n = len(exc.diagnostics)
-    print(f"{n} error{'s' if n != 1 else ''}; the station was not loaded", file=sys.stderr)
-    return 1
+FORMATS = ("text", "json")
 
 
 def cmd_stations(args: argparse.Namespace) -> int:
+    if args.format == "json":
+        print_report("stations", True, {"stations": [{"name": name, "file": str(path), "description": describe(path)}
+                                                     for name, path in bundled().items()]})
+        return 0
     for name, path in bundled().items():
         print(fit(f"{name:10} {describe(path)}", indent=" " * 11))
     return 0
@@ -38,12 +37,15 @@ def cmd_check(args: argparse.Namespace) -> int:
         station = load(args.station)
     except StationError as exc:
         if args.format == "json":
-            print(json.dumps({"station": args.station, "ok": False,
-                              "errors": [d.as_dict() for d in exc.diagnostics]}, ensure_ascii=False, indent=2))
-            return 1
-        return print_errors(exc)
+            print_report("check", False, {"station": args.station,
+                                          "errors": [d.as_dict() for d in exc.diagnostics]})
+            first = exc.diagnostics[0] if exc.diagnostics else None
+            return refuse("check", f"{first.file}:{first.line}:{first.column}: {first.message} (and "
+                          f"{len(exc.diagnostics) - 1} more); the station was not loaded" if first else
+                          "the station was not loaded", Exit.BAD_INPUT)
+        return bad_input(exc)
     if args.format == "json":
-        print(json.dumps({"ok": True, **summarise(station)}, ensure_ascii=False, indent=2))
+        print_report("check", True, summarise(station))
     else:
         print(summary_text(station))
     return 0
@@ -64,15 +66,20 @@ def cmd_generate(args: argparse.Namespace) -> int:
     from .hubgen import generate_hub
     from .loader import load_text
 
+    if args.output and (why := unwritable(Path(args.output))):
+        return refuse("generate hub", why, Exit.USAGE)
     try:
         text = generate_hub(args.turnouts, args.tracks)
     except ValueError as exc:
-        print(f"liansuo generate hub: {exc}", file=sys.stderr)
-        return 2
+        return refuse("generate hub", str(exc), Exit.USAGE)
     name = args.output or f"<hub{args.turnouts}>"
     load_text(text, name)  # what is written always loads: the generator's own check
     if args.output:
-        Path(args.output).write_text(text, encoding="utf-8")
+        try:
+            Path(args.output).write_text(text, encoding="utf-8")
+        except OSError as exc:
+            return refuse("generate hub", f"cannot write {args.output}: {exc.strerror or exc}; give -o a file in a "
+                          "folder you can write to", Exit.USAGE)
         print(f"wrote {args.output}: a hub with {args.turnouts} turnouts and {args.tracks} station tracks "
               f"(liansuo check {args.output})", file=sys.stderr)
     else:
@@ -81,23 +88,15 @@ def cmd_generate(args: argparse.Namespace) -> int:
 
 
 def register(add: Add) -> None:
-    add("stations", cmd_stations, "list the bundled stations")
+    sp = add("stations", cmd_stations, "list the bundled stations")
+    sp.add_argument("--format", choices=FORMATS, default="text", help="text (default) or json")
     sp = add("check", cmd_check, "validate a station file and summarise it")
     sp.add_argument("station", help="bundled station name or path to a station YAML file")
-    sp.add_argument("--format", choices=("text", "json"), default="text")
+    sp.add_argument("--format", choices=FORMATS, default="text", help="text (default) or json")
     add("schema", cmd_schema, "print the JSON Schema of the station format")
     sp = add("generate", cmd_generate, "write a generated station file (a hub of any size, for stress tests)")
     sp.add_argument("kind", choices=("hub",), help="what to generate: 'hub', a double-ended yard of parallel tracks")
-    sp.add_argument("--turnouts", type=_positive, required=True, metavar="N", help="turnouts in the hub")
-    sp.add_argument("--tracks", type=_positive, required=True, metavar="M", help="station tracks in the hub")
+    sp.add_argument("--turnouts", type=positive_int, required=True, metavar="N", help="turnouts in the hub")
+    sp.add_argument("--tracks", type=positive_int, required=True, metavar="M", help="station tracks in the hub")
     sp.add_argument("-o", "--output", metavar="FILE", help="write the station file here (default: stdout)")
 
-
-def _positive(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"{value} is not a positive number")
-    return value

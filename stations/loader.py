@@ -17,10 +17,11 @@ from liansuo.rules import RuleSet
 
 from .checks import cross_check
 from .doubleslip import double_slip_errors, expand_double_slips
+from .filekind import check_kind, read_source
 from .library import resolve
 from .rules import design_warnings
 from .schema import StationFile
-from .source import Diagnostic, Source, StationError, read_file, read_yaml
+from .source import Diagnostic, Source, StationError, read_yaml
 from .station import Station
 
 _HINTS = {
@@ -79,6 +80,7 @@ def _schema_diagnostics(src: Source, exc: ValidationError) -> list[Diagnostic]:
 
 
 def parse_source(src: Source, rules: RuleSet | None = None) -> Station:
+    check_kind(src, "station")
     if not isinstance(src.data, dict):
         raise StationError([src.diagnostic((), "a station file is a mapping of keys such as 'id:' and 'tracks:'",
                                            "see docs/station-format.md for a small complete example")])
@@ -107,4 +109,5 @@ def load(name_or_path: str | Path, *, rules: RuleSet | None = None) -> Station:
     """Load a bundled station by name (``jiaopei``) or any station file by path; its design warnings follow the
     design rules of ``rules`` (by default the default rule set)."""
     path = resolve(name_or_path)
-    return parse_source(read_file(path), rules)
+    return parse_source(read_source(path, "station", "give a bundled station name (see 'liansuo stations') or a "
+                                    "path"), rules)

@@ -39,11 +39,14 @@ class Diagnostic:
     severity: str = "error"
 
     def __str__(self) -> str:
-        return self.text()
+        """One line, as compilers write it (``FILE:LINE:COLUMN: error: ...``), for stderr and the tools that read
+        it; the hint on a line of its own."""
+        text = f"{self.file}:{self.line}:{self.column}: {self.severity}: {self.message}"
+        return text + (f"\n    hint: {self.hint}" if self.hint else "")
 
     def text(self, lead: str = "") -> str:
-        """The diagnostic as the command line prints it, each line starting with ``lead``, folded to fit a
-        terminal."""
+        """The diagnostic in a report on stdout (``liansuo check``): each line starting with ``lead``, folded to
+        fit a terminal, the location and the message's start on the first line."""
         text = fit(f"{lead}{self.file}:{self.line}:{self.column}: {self.severity}: {self.message}", keep=3)
         if self.hint:
             text += "\n" + fit(f"{lead}    hint: {self.hint}")
@@ -161,13 +164,16 @@ def read_yaml(text: str, file: str) -> Source:
     return src
 
 
-def read_file(path: Path, missing_hint: str = "give a bundled station name (see 'liansuo stations') or a path"
-              ) -> Source:
+def read_text(path: Path, missing_hint: str = "give a bundled station name (see 'liansuo stations') or a path"
+              ) -> str:
+    """The file's text; :class:`StationError` at ``FILE:1:1`` when it is missing or unreadable."""
     try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise StationError([Diagnostic(str(path), 1, 1, "no such file", missing_hint)]) from None
+        return path.read_text(encoding="utf-8")
+    except (FileNotFoundError, NotADirectoryError):
+        raise StationError([Diagnostic(str(path), 1, 1, f"no such file; {missing_hint}")]) from None
+    except IsADirectoryError:
+        raise StationError([Diagnostic(str(path), 1, 1, f"this is a folder, not a file; {missing_hint}")]) from None
     except (OSError, UnicodeDecodeError) as exc:
         raise StationError([Diagnostic(str(path), 1, 1, f"cannot read the file: {exc}",
-                                       "station files are UTF-8 text")]) from None
-    return read_yaml(text, str(path))
+                                       "liansuo's files are UTF-8 text")]) from None
+

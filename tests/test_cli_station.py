@@ -82,7 +82,7 @@ def _broken(tmp_path: Path) -> tuple[Path, int, int]:
 def test_check_broken_file_reports_file_line_column(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     path, line, column = _broken(tmp_path)
     code, out, err = run(capsys, "check", str(path))
-    assert code == 1
+    assert code == 3  # a bad input file
     assert out == ""
     assert f"{path}:{line}:{column}: error: " in err
     assert "'ZD6', 'ZDJ9' or 'S700K'" in err
@@ -94,7 +94,7 @@ def test_check_broken_file_reports_file_line_column(tmp_path: Path, capsys: pyte
 def test_check_broken_file_json(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     path, line, column = _broken(tmp_path)
     code, out, _ = run(capsys, "check", str(path), "--format", "json")
-    assert code == 1
+    assert code == 3  # a bad input file
     report = json.loads(out)
     assert report["ok"] is False
     (error,) = report["errors"]
@@ -106,15 +106,15 @@ def test_check_yaml_syntax_error(tmp_path: Path, capsys: pytest.CaptureFixture[s
     path = tmp_path / "syntax.yaml"
     path.write_text("id: x\nname: {zh: a, en: b\nends: []\n", encoding="utf-8")
     code, _, err = run(capsys, "check", str(path))
-    assert code == 1
-    assert f"{path}:3:" in err and "YAML syntax error" in " ".join(err.split())
+    assert code == 3  # a bad input file
+    assert f"{path}:3:" in err and "YAML syntax error" in err
     assert "Traceback" not in err
 
 
 def test_check_missing_file_says_so(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     missing = tmp_path / "nowhere.yaml"
     code, out, err = run(capsys, "check", str(missing))
-    assert code == 1
+    assert code == 3  # a bad input file
     assert f"{missing}:1:1: error: no such file" in err
     assert "liansuo stations" in err  # the hint says how to find the bundled names
     assert "Traceback" not in out + err
@@ -122,7 +122,7 @@ def test_check_missing_file_says_so(tmp_path: Path, capsys: pytest.CaptureFixtur
 
 def test_check_unknown_station_name(capsys: pytest.CaptureFixture[str]) -> None:
     code, _, err = run(capsys, "check", "no-such-station")
-    assert code == 1
+    assert code == 3  # a bad input file
     assert "no-such-station:1:1: error: no such file" in err
 
 

@@ -63,7 +63,7 @@ def test_malformed_script_is_a_collection_error_with_file_and_line(pytester: pyt
     pytester.makefile(".yaml", test_bad="station: jiaopei\ntests:\n  - name: x\n    steps:\n      - rout X XI\n")
     result = pytester.runpytest(*QUIET)
     result.assert_outcomes(errors=1)
-    assert "test_bad.yaml:5:9: error: unknown command 'rout'" in " ".join(result.stdout.str().split())
+    assert "test_bad.yaml:5:9: error: unknown command 'rout'" in result.stdout.str()
 
 
 def test_the_example_scripts_run_under_pytest(pytester: pytest.Pytester) -> None:

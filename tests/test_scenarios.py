@@ -46,7 +46,8 @@ def test_refused_step_stops_the_run_with_file_and_line(tmp_path: Path, capsys: p
 def test_malformed_scenario(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     f = tmp_path / "s.yaml"
     f.write_text("station: jiaopei\nsteps:\n  - fly X\nspeed: 3\n", encoding="utf-8")
-    assert main(["run", str(f)]) == 1
+    assert main(["run", str(f)]) == 3  # a bad input file
     err = capsys.readouterr().err
+    assert err.splitlines()[-1] == "2 errors; the scenario was not loaded"
     assert f"{f}:3:5: error: unknown command 'fly'" in err and f"{f}:4:1: error: unknown key 'speed'" in err
     assert "Traceback" not in err

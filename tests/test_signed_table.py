@@ -153,7 +153,7 @@ def test_a_table_that_cannot_be_written_says_so_and_leaves_no_file(tmp_path: Pat
                                                                    capsys: pytest.CaptureFixture[str]) -> None:
     for fmt, name in (("xlsx", "t.xlsx"), ("text", "t.txt")):
         target = tmp_path / "missing-folder" / name
-        assert main(["table", "jiaopei", "--format", fmt, "-o", str(target)]) == 1
+        assert main(["table", "jiaopei", "--format", fmt, "-o", str(target)]) == 2  # a usage error
         err = capsys.readouterr().err
         assert f"cannot write {target}" in err and "Traceback" not in err
         assert not target.exists() and not target.parent.exists()

@@ -309,7 +309,7 @@ def test_missing_file_is_a_station_error(tmp_path: Path) -> None:
         load(tmp_path / "nowhere.yaml")
     d = info.value.diagnostics[0]
     assert (d.line, d.column) == (1, 1)
-    assert "no such file" in d.message and "liansuo stations" in d.hint
+    assert "no such file" in d.message and "liansuo stations" in d.message
 
 
 def test_file_that_is_not_utf8_is_a_station_error(tmp_path: Path) -> None:

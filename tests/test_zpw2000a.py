@@ -30,6 +30,7 @@ from liansuo.circuits.zpw2000a import (
     sweep,
 )
 from liansuo.cli.main import main
+from liansuo.stations.jsonreport import version
 from liansuo.stations.library import bundled
 from liansuo.stations.loader import load, load_text
 
@@ -287,9 +288,12 @@ def test_cli_json_with_faults(capsys: pytest.CaptureFixture[str]) -> None:
 
 
 def test_cli_csv(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """``--format csv`` as ``table`` spells it: on stdout, or in the file ``-o`` names."""
     target = tmp_path / "zpw.csv"
-    assert main(["zpw", "gaotie", "--csv", str(target), "--fault", "IG:capacitor:7:half"]) == 0
-    capsys.readouterr()
+    assert main(["zpw", "gaotie", "--format", "csv", "-o", str(target), "--fault", "IG:capacitor:7:half"]) == 0
+    assert capsys.readouterr().out == f"wrote {target}\n"
+    assert main(["zpw", "gaotie", "--format", "csv", "--fault", "IG:capacitor:7:half"]) == 0
+    assert capsys.readouterr().out == target.read_bytes().decode("utf-8")
     with target.open(encoding="utf-8") as f:
         rows = list(csv.DictReader(f))
     assert len(rows) == len(load("gaotie").sections)
@@ -314,7 +318,8 @@ def test_cli_station_without_zpw_sections(capsys: pytest.CaptureFixture[str]) ->
     assert main(["zpw", "jiaopei"]) == 0
     assert "no ZPW-2000A sections" in capsys.readouterr().out
     assert main(["zpw", "jiaopei", "--format", "json"]) == 0
-    assert json.loads(capsys.readouterr().out) == {"station": "jiaopei", "sections": []}
+    assert json.loads(capsys.readouterr().out) == {"liansuo": version(), "schema": 1, "ok": True,
+                                                   "station": "jiaopei", "sections": []}
     assert main(["zpw", "jiaopei", "--fault", "IG:capacitor:1:open"]) == 2
     assert "not a ZPW-2000A section" in capsys.readouterr().err
 

@@ -1,6 +1,8 @@
 """``liansuo tui`` and ``liansuo replay``, registered by the command line (``cli/main.py``).
 
-Textual is imported only when a console actually starts, so the rest of the command line stays quick.
+Textual is imported only when a console actually starts, so the rest of the command line stays quick. Every argument
+(the station, ``--speed``, ``--exercise``, ``--record``, the recording) is checked before a console starts: a bad one
+ends the command with its one-line message and exit status (docs/commands.md, "Exit status").
 """
 
 from __future__ import annotations
@@ -8,6 +10,12 @@ from __future__ import annotations
 import argparse
 import sys
 from collections.abc import Callable
+from pathlib import Path
+
+from liansuo.stations.arguments import positive_number, unwritable
+from liansuo.stations.exitcodes import Exit, bad_input, refuse
+from liansuo.stations.source import StationError
+from liansuo.stations.station import Station
 
 Handler = Callable[[argparse.Namespace], int]
 Add = Callable[[str, Handler, str], argparse.ArgumentParser]
@@ -17,7 +25,8 @@ def register(add: Add) -> None:
     sp = add("tui", cmd_tui, "open the operator console (操作表示机) on a station")
     sp.add_argument("station", nargs="?", default="jiaopei", help="bundled station name or path (default jiaopei)")
     sp.add_argument("--paused", action="store_true", help="start with the clock paused")
-    sp.add_argument("--speed", type=float, default=1.0, help="simulated seconds per wall-clock second (default 1)")
+    sp.add_argument("--speed", type=positive_number, default=1.0, metavar="X",
+                    help="simulated seconds per wall-clock second, greater than 0 (default 1)")
     sp.add_argument("--record", metavar="FILE", help="record the session (JSON lines) for 'liansuo replay'")
     sp.add_argument("--exercise", metavar="FILE",
                     help="load an exercise: a file, or a bundled one by name (jiaopei-broken-rail-IG, ...)")
@@ -28,35 +37,45 @@ def register(add: Add) -> None:
 def register_replay(add: Add) -> None:
     sp = add("replay", cmd_replay, "play a recorded session back in the console, with seek and speed")
     sp.add_argument("file", help="a recording written by 'liansuo tui --record FILE'")
-    sp.add_argument("--speed", type=float, default=1.0, help="playback speed (default 1)")
+    sp.add_argument("--speed", type=positive_number, default=1.0, metavar="X",
+                    help="playback speed, greater than 0 (default 1)")
     sp.add_argument("--verify", action="store_true",
                     help="no console: re-simulate the whole recording and check it reproduces the recorded outputs")
+    sp.add_argument("--format", choices=("text", "json"), default="text",
+                    help="with --verify: text (default) or json")
 
 
-def _station_ok(station: str) -> str:
+def _load(station: str) -> Station | StationError:
     from liansuo.stations.loader import load
-    from liansuo.stations.source import StationError
 
     try:
-        load(station)
+        return load(station)
     except StationError as exc:
-        return "\n".join(str(d) for d in exc.diagnostics)
-    return ""
+        return exc
 
 
 def cmd_tui(args: argparse.Namespace) -> int:
-    why = _station_ok(args.station)
-    if why:
-        print(why, file=sys.stderr)
-        return 1
+    if isinstance(station := _load(args.station), StationError):
+        return bad_input(station)
+    if args.record and (why := unwritable(Path(args.record), "--record")):
+        return refuse("tui", why, Exit.USAGE)
+    if args.exercise:
+        from liansuo.simulation.exercise import parse_exercise
+
+        try:
+            ex = parse_exercise(args.exercise)
+        except StationError as exc:
+            return bad_input(exc, "exercise")
+        if ex.station_ref() not in (args.station, station.id):
+            return refuse("tui", f"exercise '{ex.title}' is for station {ex.station}; start the console with "
+                          f"'liansuo tui {ex.station} --exercise {args.exercise}'", Exit.USAGE)
     from .app import ConsoleApp
 
     try:
         app = ConsoleApp(args.station, paused=args.paused, speed=args.speed, record=args.record,
                          exercise=args.exercise, instructor_password=args.instructor_password)
     except OSError as exc:
-        print(f"liansuo tui: {exc}", file=sys.stderr)
-        return 1
+        return refuse("tui", str(exc), Exit.BAD_INPUT)
     app.run()
     return 0
 
@@ -64,23 +83,32 @@ def cmd_tui(args: argparse.Namespace) -> int:
 def cmd_replay(args: argparse.Namespace) -> int:
     from liansuo.simulation.recording import RecordingError, Replayer, load_recording
 
+    if args.format == "json" and not args.verify:
+        return refuse("replay", "--format json goes with --verify (the console has no JSON)", Exit.USAGE)
     try:
         rec = load_recording(args.file)
     except RecordingError as exc:
         print(exc, file=sys.stderr)
-        return 1
-    why = _station_ok(rec.station)
-    if why:
-        print(why, file=sys.stderr)
-        return 1
+        return int(Exit.BAD_INPUT)
+    if isinstance(station := _load(rec.station), StationError):
+        return bad_input(station, f"station of {args.file}")
     if args.verify:
         bad = Replayer(rec).verify()
-        for line in bad:
-            print(line)
         cmds = len(rec.commands)
-        verdict = "outputs reproduced" if not bad else f"{len(bad)} mismatches"
-        print(f"{rec.cycles} cycles ({rec.duration:g} s), {cmds} commands: {verdict}")
-        return 0 if not bad else 1
+        if args.format == "json":
+            from liansuo.stations.jsonreport import print_report
+
+            print_report("replay", not bad, {"recording": rec.path, "station": rec.station, "cycles": rec.cycles,
+                                             "duration_s": round(rec.duration, 2), "commands": cmds,
+                                             "mismatches": bad})
+        else:
+            for line in bad:
+                print(line)
+            verdict = "outputs reproduced" if not bad else f"{len(bad)} mismatches"
+            print(f"{rec.cycles} cycles ({rec.duration:g} s), {cmds} commands: {verdict}")
+        if bad:
+            return refuse("replay", f"{len(bad)} of the recorded outputs not reproduced", Exit.FAILED)
+        return 0
     from .replay import ReplayApp
 
     ReplayApp(rec, speed=args.speed).run()

@@ -4,9 +4,10 @@
 from __future__ import annotations
 
 import argparse
-import json
-import sys
 from collections.abc import Callable
+
+from liansuo.stations.exitcodes import Exit, bad_input, refuse
+from liansuo.stations.jsonreport import print_report
 
 from ..spread import SpreadError, count
 
@@ -23,24 +24,28 @@ def cmd_verify(args: argparse.Namespace) -> int:
                              workers=args.workers or (1 if args.scheduler else 0), scheduler=args.scheduler,
                              show_progress=None)
     except StationError as exc:
-        for d in exc.diagnostics:
-            print(d, file=sys.stderr)
-        print(f"{len(exc.diagnostics)} error(s); the station was not loaded", file=sys.stderr)
-        return 1
+        return bad_input(exc)
     except SpreadError as exc:
-        print(f"liansuo verify: {exc}", file=sys.stderr)
-        return 2
+        return refuse("verify", str(exc), Exit.USAGE)
+    if args.route and not rep.results:
+        return refuse("verify", f"no route {' or '.join(args.route)} in {rep.station}; 'liansuo table "
+                      f"{args.station}' lists the routes", Exit.NOTHING_SELECTED)
     if args.format == "json":
-        print(json.dumps(rep.as_dict(), ensure_ascii=False, indent=2))
+        print_report("verify", rep.ok, rep.as_dict())
     else:
         print(report_text(rep, verbose=args.verbose))
-    return 0 if rep.ok else 1
+    if not rep.ok:
+        n = len(rep.failures)
+        why = (f"{n} check{'s' if n != 1 else ''} failed" if n else
+               f"{len(rep.warnings)} design-rule warning{'s' if len(rep.warnings) != 1 else ''} with --strict")
+        return refuse("verify", f"{why} on {rep.station}", Exit.FAILED)
+    return 0
 
 
 def register(add: Add) -> None:
     sp = add("verify", cmd_verify, "run the interlocking test (联锁试验) of every route and pair of routes")
     sp.add_argument("station", help="bundled station name or path to a station YAML file")
-    sp.add_argument("--format", choices=("text", "json"), default="text")
+    sp.add_argument("--format", choices=("text", "json"), default="text", help="text (default) or json")
     sp.add_argument("--strict", action="store_true", help="design-rule warnings (dead zones ...) fail too")
     sp.add_argument("--route", action="append", metavar="ID", help="test only this route and its pairs (repeatable)")
     sp.add_argument("--no-pairs", action="store_true", help="skip the pairs of routes")
