@@ -5,7 +5,9 @@ from __future__ import annotations
 
 import argparse
 import sys
+import time
 from collections.abc import Callable
+from datetime import datetime
 from pathlib import Path
 
 from liansuo.simulation.timeparse import parse_duration
@@ -16,14 +18,15 @@ from liansuo.stations.source import StationError
 
 from .junit import write_junit
 from .scenario import parse_scenario, run_scenario
-from .scripts import Outcome, parse_script, run_script
+from .scripts import Outcome, Unrunnable, parse_script, run_script
 
 Add = Callable[..., argparse.ArgumentParser]
 
 
 def cmd_test(args: argparse.Namespace) -> int:
+    started, start = datetime.now(), time.perf_counter()
     outcomes: list[Outcome] = []
-    broken = 0
+    unrunnable: list[Unrunnable] = []
     for f in args.files:
         try:
             script = parse_script(Path(f))
@@ -31,7 +34,7 @@ def cmd_test(args: argparse.Namespace) -> int:
         except StationError as exc:
             for d in exc.diagnostics:
                 print(d, file=sys.stderr)
-            broken += 1
+            unrunnable.append(Unrunnable(f, [str(d) for d in exc.diagnostics]))
     for o in outcomes:
         if o.passed:
             print(f"PASS {o.script}: {o.name}")
@@ -43,9 +46,9 @@ def cmd_test(args: argparse.Namespace) -> int:
                 for entry in o.log:
                     print(f"      {entry}")
     if args.junit_xml:
-        write_junit(args.junit_xml, outcomes)
+        write_junit(args.junit_xml, outcomes, unrunnable, started=started, time_s=time.perf_counter() - start)
     passed = sum(o.passed for o in outcomes)
-    failed = len(outcomes) - passed + broken
+    failed = len(outcomes) - passed + len(unrunnable)
     print(f"{passed} passed, {failed} failed")
     return 0 if failed == 0 and outcomes else 1
 
