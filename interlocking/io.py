@@ -19,6 +19,10 @@ class Result:
     ok: bool
     message: str = ""
 
+    def __bool__(self) -> bool:
+        """``ok``: ``if sim.command("route X XI"):`` reads as it says."""
+        return self.ok
+
     @staticmethod
     def accept(message: str = "") -> Result:
         return Result(True, message)

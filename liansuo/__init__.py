@@ -7,8 +7,9 @@ The public API::
     station = liansuo.load_station("jiaopei")   # a bundled name or a path to a station file
     table = liansuo.build_table(station)        # the interlocking table (联锁表)
     sim = liansuo.Simulation(station)           # the station with its field and interlocking
-    sim.command("route X XI")                   # Result(ok=True, message='route X-XI selected')
+    sim.command("route X XI")                   # Result(ok=True, message='route X-XI selected'), true when ok
     sim.run(5)                                  # simulated seconds
+    sim.aspect("X")                             # 'U'; an id the station lacks raises liansuo.UnknownId (a KeyError)
     report = liansuo.verify_station(station)    # the automatic interlocking test (联锁试验)
 
 The packages below are the layers (docs/architecture.md): ``rules`` (the national rule sets, docs/rules.md),
@@ -29,6 +30,7 @@ if TYPE_CHECKING:
     from liansuo.interlocking.table import build_table
     from liansuo.proving.verify import VerifyReport, verify_station
     from liansuo.simulation.sim import Simulation
+    from liansuo.simulation.unknown import UnknownId
     from liansuo.stations.loader import load as load_station
     from liansuo.stations.loader import load_text as load_station_text
     from liansuo.stations.source import StationError
@@ -39,6 +41,7 @@ __version__ = "0.1.0"
 _WHERE = {
     "Simulation": ("liansuo.simulation.sim", "Simulation"),
     "Result": ("liansuo.interlocking.io", "Result"),
+    "UnknownId": ("liansuo.simulation.unknown", "UnknownId"),
     "Station": ("liansuo.stations.station", "Station"),
     "StationError": ("liansuo.stations.source", "StationError"),
     "load_station": ("liansuo.stations.loader", "load"),
@@ -50,8 +53,8 @@ _WHERE = {
     "VerifyReport": ("liansuo.proving.verify", "VerifyReport"),
 }
 
-__all__ = ["InterlockingTable", "Result", "Route", "Simulation", "Station", "StationError", "VerifyReport",
-           "__version__", "build_table", "load_station", "load_station_text", "verify_station"]
+__all__ = ["InterlockingTable", "Result", "Route", "Simulation", "Station", "StationError", "UnknownId",
+           "VerifyReport", "__version__", "build_table", "load_station", "load_station_text", "verify_station"]
 
 
 def __getattr__(name: str) -> Any:

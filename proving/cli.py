@@ -8,7 +8,9 @@ status 3 and nothing run or written (docs/commands.md, "Exit status").
 from __future__ import annotations
 
 import argparse
+import time
 from collections.abc import Callable
+from datetime import datetime
 from pathlib import Path
 
 from liansuo.simulation.timeparse import parse_duration
@@ -22,35 +24,38 @@ from liansuo.stations.station import Station
 
 from .junit import write_junit
 from .scenario import ScenarioLog, parse_scenario, run_scenario, station_of
-from .scripts import Outcome, Script, parse_script, run_script, script_station, selected
+from .scripts import Outcome, Script, Unrunnable, parse_script, run_script, script_station, selected
 
 Add = Callable[..., argparse.ArgumentParser]
 FORMATS = ("text", "json")
 
 
-def _load_scripts(files: list[str]) -> list[tuple[Script, Station]] | int:
-    """Every script with its station, or the exit status of the first that did not load (all are reported)."""
+def _load_scripts(files: list[str]) -> tuple[list[tuple[Script, Station]], list[Unrunnable], int]:
+    """Every script with its station; those that did not load (each reported on stderr) and the exit status."""
     scripts: list[tuple[Script, Station]] = []
+    unrunnable: list[Unrunnable] = []
     status = 0
     for f in files:
+        what = "test script"
         try:
             script = parse_script(Path(f))
-        except StationError as exc:
-            status = bad_input(exc, "test script")
-            continue
-        try:
+            what = f"station of {f}"
             scripts.append((script, script_station(script)))
         except StationError as exc:
-            status = bad_input(exc, f"station of {f}")
-    return status or scripts
+            status = bad_input(exc, what)
+            unrunnable.append(Unrunnable(f, [str(d) for d in exc.diagnostics]))
+    return scripts, unrunnable, status
 
 
 def cmd_test(args: argparse.Namespace) -> int:
     if args.junit_xml and (why := unwritable(Path(args.junit_xml), "--junit-xml")):
         return refuse("test", why, Exit.USAGE)
-    loaded = _load_scripts(args.files)
-    if isinstance(loaded, int):
-        return loaded
+    started, start = datetime.now(), time.perf_counter()
+    loaded, unrunnable, status = _load_scripts(args.files)
+    if unrunnable:  # nothing runs; a CI server still gets the report, each such script an error (as pytest does)
+        if args.junit_xml:
+            write_junit(args.junit_xml, [], unrunnable, started=started, time_s=time.perf_counter() - start)
+        return status
     if not any(selected(script, args.k) for script, _ in loaded):
         total = sum(len(script.tests) for script, _ in loaded)
         return refuse("test", f"no test name contains {args.k!r} (of {total} test{'s' if total != 1 else ''} in "
@@ -67,7 +72,7 @@ def cmd_test(args: argparse.Namespace) -> int:
         _print_outcomes(outcomes, args.verbose)
         print(f"{passed} passed, {failed} failed")
     if args.junit_xml:
-        write_junit(args.junit_xml, outcomes)
+        write_junit(args.junit_xml, outcomes, started=started, time_s=time.perf_counter() - start)
     if failed:
         return refuse("test", f"{failed} of {len(outcomes)} test{'s' if len(outcomes) != 1 else ''} failed",
                       Exit.FAILED)

@@ -110,10 +110,7 @@ class ScriptItem(pytest.Item):
     def repr_failure(self, excinfo: pytest.ExceptionInfo[BaseException],
                      style: Any = None) -> str:
         if isinstance(excinfo.value, ScriptFailure):
-            o = excinfo.value.args[0]
-            lines = [f"FAIL {o.script}:{o.line}: {o.name}", f"    {o.failure}", "  steps:"]
-            lines += [f"    {entry}" for entry in o.log]
-            return "\n".join(lines)
+            return str(excinfo.value.args[0].report())
         return str(super().repr_failure(excinfo))
 
     def reportinfo(self) -> tuple[Path, int, str]:

@@ -19,6 +19,7 @@ test, and ``expect hazard TEXT`` checks that one was seen.
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -63,11 +64,26 @@ class Outcome:
     line: int = 0
     log: list[str] = field(default_factory=list)
     hazards: list[str] = field(default_factory=list)  # what the oracle found that the interlocking cannot see
+    time_s: float = 0.0  # wall-clock seconds the test took to run
+
+    def report(self) -> str:
+        """A failure as ``liansuo test -v`` prints it: where, which step and why, then every step's answer."""
+        lines = [f"FAIL {self.script}:{self.line}: {self.name}", f"    {self.failure}", "  steps:"]
+        return "\n".join(lines + [f"    {entry}" for entry in self.log])
 
     def as_dict(self) -> dict[str, object]:
         """The outcome as ``liansuo test --format json`` lists it (docs/commands.md)."""
         return {"script": self.script, "name": self.name, "passed": self.passed, "line": self.line or None,
                 "failure": self.failure or None, "hazards": self.hazards, "log": [] if self.passed else self.log}
+
+
+@dataclass
+class Unrunnable:
+    """A script that could not be run at all (it is malformed, or its station does not load): an error, as opposed
+    to a test whose expectation failed."""
+
+    script: str
+    diagnostics: list[str]  # FILE:LINE:COLUMN: error: ... each
 
 
 def parse_script(path: Path) -> Script:
@@ -146,12 +162,21 @@ def run_script(script: Script, only: str | None = None, station: Station | None 
 
 
 def run_test(script: Script, test: ScriptTest, station: Station, table: object) -> Outcome:
+    """Run one test on a fresh simulation; the outcome carries the wall-clock time it took."""
+    start = time.perf_counter()
+    outcome = _run_steps(script, test, station, table)
+    outcome.time_s = time.perf_counter() - start
+    return outcome
+
+
+def _run_steps(script: Script, test: ScriptTest, station: Station, table: object) -> Outcome:
     sim = Simulation(station, cycle_s=script.cycle_s, table=table)  # type: ignore[arg-type]
     checker = Watch(sim) if script.safety else None
     log: list[str] = []
     steps = test.steps
     for k, step in enumerate(steps):
-        result = _expect_hazard(step.text, checker) or sim.command(step.text)
+        hazard = _expect_hazard(step.text, checker)
+        result = hazard if hazard is not None else sim.command(step.text)
         log.append(f"{step.text} -> {'ok' if result.ok else 'refused'}: {result.message}")
         if checker is not None and checker.violations:
             v = checker.violations[0]

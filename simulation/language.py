@@ -19,6 +19,8 @@ from typing import Generic, TypeVar
 from liansuo.interlocking.io import Result
 from liansuo.stations.source import Diagnostic, Source
 
+from .unknown import UnknownId
+
 W = TypeVar("W")
 W_contra = TypeVar("W_contra", contravariant=True)
 
@@ -54,7 +56,8 @@ class Language(Generic[W]):
         return c.usage if c is not None else ""
 
     def execute(self, world: W, line: str) -> Result:
-        """Run one line (a ``#`` starts a comment); an unknown command is refused with the list of commands."""
+        """Run one line (a ``#`` starts a comment); an unknown command is refused with the list of commands, and a
+        command naming an element the station does not have with the closest ids."""
         text = line.split("#", 1)[0].strip()
         if not text:
             return Result.accept("")
@@ -65,7 +68,10 @@ class Language(Generic[W]):
         c = self._commands.get(words[0])
         if c is None:
             return Result.refuse(f"unknown command '{words[0]}'; commands: {', '.join(sorted(self._commands))}")
-        return c.handler(world, words[1:])
+        try:
+            return c.handler(world, words[1:])
+        except UnknownId as exc:  # the command names an element the station does not have
+            return Result.refuse(str(exc))
 
     def read_steps(self, src: Source, loc: tuple[str | int, ...], raw: object,
                    errors: list[Diagnostic]) -> list[tuple[str, int]]:

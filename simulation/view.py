@@ -6,7 +6,9 @@ interface (:class:`~interlocking.io.RelayBoard` in, :class:`~interlocking.io.Out
 field and is handed on as it is.
 
 Records are frozen: each is the state of one element at the moment it was asked for. :class:`InterlockingView` is the
-live reader the world keeps (``World.view``), renewed when the interlocking restarts.
+live reader the world keeps (``World.view``), renewed when the interlocking restarts. A question about an id the
+station does not have raises :class:`~simulation.unknown.UnknownId` (a ``KeyError``) naming the kind, the id and the
+closest ids; a known element in its rest state answers as such ('' aspect, route 'released', no cab code).
 """
 
 from __future__ import annotations
@@ -18,6 +20,8 @@ from liansuo.interlocking.cbi import Interlocking
 from liansuo.interlocking.io import Event, Outputs, RelayBoard
 from liansuo.interlocking.locks import Hold
 from liansuo.interlocking.state import RouteStage, RouteState
+
+from .unknown import require
 
 # alarm kinds of the interlocking that concern a signal (the console marks its name)
 SIGNAL_ALARMS = frozenset({"closed", "lamp", "red", "filament", "flasher"})
@@ -91,15 +95,23 @@ class AlarmView:
 
 @dataclass(frozen=True)
 class TrainView:
-    """What a front end shows of a train: its name, the sections its wheelsets shunt, speed and direction."""
+    """What a front end shows of a train: its name, the sections its wheelsets shunt, speed and direction, and where
+    its head is. A train whose head has run out over the station's boundary has no position in the station: it is
+    ``leaving`` while its rear is still in, then ``left`` (it is then no longer among the trains in the yard)."""
 
     name: str
-    sections: tuple[str, ...]
+    sections: tuple[str, ...]  # () once it has left
     speed_kmh: float
     direction: str  # "down" or "up"
     mode: str  # "manual", "signal", "auto"
-    head_track: str
-    head_m: float  # position of the leading wheelset along the line
+    head_track: str | None  # the track of the leading wheelset; None once the head is beyond the boundary
+    head_m: float | None  # position of the leading wheelset along the line; None once beyond the boundary
+    state: str = "running"  # running, derailed, leaving (head beyond the boundary, rear still in), left
+
+    @property
+    def left(self) -> bool:
+        """The whole train has run out of the station."""
+        return self.state == "left"
 
 
 class InterlockingView:
@@ -107,6 +119,15 @@ class InterlockingView:
 
     def __init__(self, interlocking: Interlocking) -> None:
         self._il = interlocking
+        core = interlocking.core
+        st = core.station
+        self._station = st.id
+        self._signals = core.signals
+        self._turnouts = core.turnouts
+        self._sections = st.sections
+        self._routes = core.table.routes
+        self._lines = frozenset(lk.id for lk in st.model.links)
+        self._doors = frozenset(k for keys in core.platform_doors.values() for k in keys)
 
     # ---- the relay interface ----------------------------------------------------------------------------------
     @property
@@ -121,6 +142,8 @@ class InterlockingView:
 
     # ---- signals ------------------------------------------------------------------------------------------------
     def aspect(self, signal: str) -> str:
+        """The signal's commanded aspect code ('' while it commands none)."""
+        require("signal", signal, self._signals, self._station)
         return self._il.out.signals.get(signal, "")
 
     def aspects(self) -> Mapping[str, str]:
@@ -128,6 +151,7 @@ class InterlockingView:
         return self._il.out.signals
 
     def signal(self, signal: str) -> SignalView:
+        require("signal", signal, self._signals, self._station)
         return self._signal(signal, self._signal_alarms().get(signal, set()))
 
     def signals(self) -> tuple[SignalView, ...]:
@@ -148,11 +172,14 @@ class InterlockingView:
 
     # ---- routes -------------------------------------------------------------------------------------------------
     def route(self, route_id: str) -> RouteView | None:
+        """The route of the table with this id, None while the interlocking does not hold it."""
+        require("route", route_id, self._routes, self._station)
         rs = self._il.routes.get(route_id)
         return None if rs is None else _route(rs)
 
     def route_of(self, signal: str) -> RouteView | None:
         """The route set from ``signal``, if any."""
+        require("signal", signal, self._signals, self._station)
         rid = self._il.by_signal.get(signal)
         return None if rid is None else self.route(rid)
 
@@ -161,12 +188,14 @@ class InterlockingView:
         return tuple(_route(rs) for rs in self._il.routes.values())
 
     def route_state(self, route_id: str) -> str:
-        """The route's state word, 'released' when the interlocking holds no such route."""
+        """The route's state word, 'released' while the interlocking does not hold it."""
+        require("route", route_id, self._routes, self._station)
         rs = self._il.routes.get(route_id)
         return "released" if rs is None else rs.stage.value
 
     # ---- turnouts and sections ----------------------------------------------------------------------------------
     def turnout(self, turnout: str) -> TurnoutView:
+        require("turnout", turnout, self._turnouts, self._station)
         il = self._il
         locks = il.locks.turnout_locks(turnout)
         holds = {lk.hold for lk, _, _ in locks}
@@ -177,6 +206,7 @@ class InterlockingView:
 
     def turnout_locked(self, turnout: str) -> bool:
         """``turnout(turnout).locked`` alone: cheaper, for readers that ask it of many turnouts every cycle."""
+        require("turnout", turnout, self._turnouts, self._station)
         return self._il.locks.turnout_locked(turnout)
 
     def turnouts(self) -> tuple[TurnoutView, ...]:
@@ -184,6 +214,7 @@ class InterlockingView:
         return tuple(self.turnout(t) for t in self._il.core.turnouts)
 
     def section(self, section: str) -> SectionView:
+        require("section", section, self._sections, self._station)
         return SectionView(section, not self._il.board.clear(section), self._il.locks.section_locked(section))
 
     def sections(self, ids: Sequence[str]) -> tuple[SectionView, ...]:
@@ -192,15 +223,18 @@ class InterlockingView:
     # ---- doors, lines, codes ------------------------------------------------------------------------------------
     def doors_safe(self, key: str) -> bool:
         """The screen doors ``platform:side`` are proven closed and locked (PDKJ), or bypassed (PDQCJ)."""
+        require("platform door", key, self._doors, self._station)
         return self._il.board.doors_safe(key)
 
     def line_outbound(self, link: str) -> bool:
         """The direction circuit of an automatic line is set for our departures (改方)."""
+        require("line", link, self._lines, self._station)
         return self._il.out.line_direction.get(link) == "outbound"
 
     def block_line(self, link: str) -> str | None:
         """The state of a 64D block line (idle, requested, ...) or of a station-block line (idle, outbound,
-        departed, inbound, arriving), None if there is no such line."""
+        departed, inbound, arriving); None for an automatic-block line, which has neither."""
+        require("line", link, self._lines, self._station)
         bl = self._il.core.links.get(link)
         if bl is not None:
             return bl.state.value
@@ -209,6 +243,7 @@ class InterlockingView:
 
     def cab_code(self, section: str) -> str | None:
         """The low-frequency code a coded section carries, None when it carries none."""
+        require("section", section, self._sections, self._station)
         return self._il.out.cab_codes.get(section)
 
     # ---- alarms and events --------------------------------------------------------------------------------------

@@ -27,6 +27,8 @@ from .neighbour import Neighbours
 from .trains.engine import MotionEngine
 from .trains.engines import attach_engine, make_engine
 from .trains.fleet import Fleet, Train
+from .trains.movement import OUTSIDE
+from .unknown import UnknownId, close_matches
 from .view import AlarmView, InterlockingView, TrainView
 from .wiring import Wiring
 
@@ -134,7 +136,7 @@ class World:
     def after_move(self) -> None:
         """What happens on board after the trains moved (the ATO's platform doors)."""
 
-    # ---- queries ----------------------------------------------------------------------------------------------
+    # ---- queries: each raises UnknownId (a KeyError) for an id the station does not have ---------------------------
     def aspect(self, signal: str) -> str:
         return self.view.aspect(signal)
 
@@ -163,13 +165,27 @@ class World:
         return self.view.line_outbound(link)
 
     def train_views(self) -> list[TrainView]:
-        """Every train in the yard."""
-        out = []
-        for tr in self.fleet.trains.values():
-            track, x = self.fleet.front(tr)
-            out.append(TrainView(tr.name, self.fleet.sections_of(tr), round(tr.speed_kmh, 2), tr.direction.value,
-                                 tr.mode, track, round(x, 2)))
-        return out
+        """Every train in the yard (those that have left the station are no longer in it: ask ``train_view``)."""
+        return [self._train_view(tr) for tr in self.fleet.trains.values()]
+
+    def train_view(self, name: str) -> TrainView:
+        """One train by name, in the yard or gone: a train that has run out of the station answers with
+        ``state == 'left'`` (``left``) and no position, until a new train takes its name."""
+        tr = self.fleet.trains.get(name)
+        if tr is not None:
+            return self._train_view(tr)
+        gone = self.fleet.departed.get(name)
+        if gone is not None:
+            return TrainView(name, (), 0.0, gone.direction, gone.mode, None, None, "left")
+        known = [*self.fleet.trains, *self.fleet.departed]
+        raise UnknownId("train", name, close_matches(name, known), self.station.id)
+
+    def _train_view(self, tr: Train) -> TrainView:
+        track, x = self.fleet.front(tr)
+        sections, speed = self.fleet.sections_of(tr), round(tr.speed_kmh, 2)
+        if track == OUTSIDE:  # the head has run out over the boundary; the rear is still in
+            return TrainView(tr.name, sections, speed, tr.direction.value, tr.mode, None, None, "leaving")
+        return TrainView(tr.name, sections, speed, tr.direction.value, tr.mode, track, round(x, 2), tr.state)
 
     def alarm_views(self) -> list[AlarmView]:
         """Active alarms: the interlocking's, then the world's."""

@@ -8,6 +8,7 @@ import sys
 from pathlib import Path
 
 import pytest
+import xmlschema
 
 pytest_plugins = ["pytester"]
 
@@ -43,6 +44,7 @@ def test_scripts_are_collected_and_failures_show_step_expectation_and_state(pyte
     assert "step 'expect signal X L': signal X shows U, expected L" in out
     assert "route X XI -> ok: route X-XI selected" in out
     assert 'name="receiving route opens"' in (pytester.path / "report.xml").read_text("utf-8")
+    xmlschema.validate(pytester.path / "report.xml", ROOT / "tests" / "data" / "junit-10.xsd")  # as Jenkins reads it
 
 
 def test_keyword_selection_and_explicit_paths(pytester: pytest.Pytester) -> None:

@@ -65,6 +65,14 @@ r = sim.command("route X XI")
 assert r.ok, r
 sim.run(2)
 print("route X-XI", sim.route_state("X-XI"), "signal X", sim.aspect("X"))
+assert not sim.command("route X XY"), "a refused Result is false"
+try:
+    sim.aspect("NOSUCH")
+except liansuo.UnknownId as exc:
+    print("unknown", exc.kind, exc.id)
+from importlib.resources import files
+
+print("typed", files("liansuo").joinpath("py.typed").is_file())  # the marker type checkers look for
 table = liansuo.build_table(liansuo.load_station("jiaopei"))
 print("table", len(table.routes), "routes, X-XI conflicts with", ", ".join(sorted(table.routes["X-XI"].conflicts)[:3]))
 from liansuo.proving.mutation import default_stations  # the example stations install too: mutate runs on them
@@ -308,6 +316,7 @@ def test_the_public_api_runs_from_the_installed_package(installed: Installed) ->
     assert package.is_relative_to(installed.venv.resolve()), f"liansuo was imported from {package}, not the venv"
     assert "route X-XI open signal X U" in out, f"the public API:\n{out}"
     assert "table 25 routes" in out, f"the public API:\n{out}"
+    assert "unknown signal NOSUCH" in out and "typed True" in out, f"the public API:\n{out}"
     assert "danxian.yaml" in out and "shuangxian.yaml" in out, f"the example stations are not installed:\n{out}"
 
 

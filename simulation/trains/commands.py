@@ -139,7 +139,7 @@ def _named(sim: Yard, args: list[str], usage: str, n: int) -> tuple[str, Result 
 
 def _drive(sim: Yard, args: list[str]) -> Result:
     name, bad = _named(sim, args, "drive", 2)
-    if bad:
+    if bad is not None:
         return bad
     try:
         kmh = float(args[1])
@@ -160,7 +160,7 @@ def _drive(sim: Yard, args: list[str]) -> Result:
 
 def _stop(sim: Yard, args: list[str]) -> Result:
     name, bad = _named(sim, args, "stop", 1)
-    if bad:
+    if bad is not None:
         return bad
     tr = sim.fleet.trains[name]
     tr.mode = "manual"
@@ -194,7 +194,7 @@ def _auto(sim: Yard, args: list[str]) -> Result:
 
 def _slip(sim: Yard, args: list[str]) -> Result:
     name, bad = _named(sim, args, "slip", 3)
-    if bad:
+    if bad is not None:
         return bad
     try:
         ratio = float(args[1])
@@ -212,7 +212,7 @@ def _slip(sim: Yard, args: list[str]) -> Result:
 
 def _estop(sim: Yard, args: list[str]) -> Result:
     name, bad = _named(sim, args, "estop", 2)
-    if bad:
+    if bad is not None:
         return bad
     tr = sim.fleet.trains[name]
     tr.estops.apply(args[1])
@@ -240,7 +240,7 @@ def _estop_release(sim: Yard, args: list[str]) -> Result:
 
 def _reverse(sim: Yard, args: list[str]) -> Result:
     name, bad = _named(sim, args, "reverse", 1)
-    if bad:
+    if bad is not None:
         return bad
     tr = sim.fleet.trains[name]
     if tr.speed_ms > 0.01:

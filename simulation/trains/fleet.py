@@ -78,6 +78,16 @@ class Train:
 Aspects = Callable[[], dict[str, str]]
 
 
+@dataclass(frozen=True)
+class Departure:
+    """A train that has run out of the station over a boundary: what is left to tell of it."""
+
+    name: str
+    direction: str  # "down" or "up"
+    mode: str
+    t: float  # when its last wheelset left
+
+
 class Fleet:
     """Every train of one simulation."""
 
@@ -93,6 +103,7 @@ class Fleet:
         self.aspects = aspects
         self.notify = notify
         self.trains: dict[str, Train] = {}
+        self.departed: dict[str, Departure] = {}  # trains that have left the station, until the name is used again
         self.t = 0.0
         self.dt = 0.25
 
@@ -107,6 +118,7 @@ class Fleet:
             return why
         train = Train(name, consist, pos, mode)
         self.trains[name] = train
+        self.departed.pop(name, None)
         return ""
 
     def remove(self, name: str) -> None:
@@ -181,6 +193,7 @@ class Fleet:
         if all(mv[0] == OUTSIDE for mv in tr.pos.moves):
             tr.state = "left"
             self.notify("train", f"train {tr.name} has left the station")
+            self.departed[tr.name] = Departure(tr.name, tr.direction.value, tr.mode, self.t)
             self.remove(tr.name)
         del moved
 
@@ -304,4 +317,4 @@ class Fleet:
         return move[0], self.track.x_at(move, tr.pos.front_s)
 
 
-__all__ = ["MODES", "Fleet", "PlatformStop", "Train"]
+__all__ = ["MODES", "Departure", "Fleet", "PlatformStop", "Train"]
