@@ -9,9 +9,12 @@ from __future__ import annotations
 
 import argparse
 from collections.abc import Callable, Sequence
+from importlib.metadata import PackageNotFoundError
+from importlib.metadata import version as distribution_version
 
 from liansuo.bench import cli as bench
 from liansuo.circuits import zpwcli
+from liansuo.cli import completion, schemas
 from liansuo.interlocking import cli as interlocking
 from liansuo.proving import cli as proving
 from liansuo.proving import mutation, soakcli
@@ -24,7 +27,8 @@ Add = Callable[[str, Handler, str], argparse.ArgumentParser]
 
 # in the order of the help: the station, its table and track circuits, proving it, timing it, the console
 REGISTER: tuple[Callable[[Add], None], ...] = (
-    stations.register,  # stations, check, schema
+    stations.register,  # stations, check, generate
+    schemas.register,  # schema
     interlocking.register,  # table
     zpwcli.register,  # zpw
     proving.register_run,  # run
@@ -38,8 +42,17 @@ REGISTER: tuple[Callable[[Add], None], ...] = (
 )
 
 
+def version() -> str:
+    """The installed liansuo's version, from its distribution's metadata."""
+    try:
+        return distribution_version("liansuo")
+    except PackageNotFoundError:  # run from a checkout that was never installed
+        return "unknown (not installed)"
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="liansuo", description="Station signalling and interlocking simulator (联锁)")
+    p.add_argument("--version", action="version", version=f"liansuo {version()}")
     sub = p.add_subparsers(dest="command", metavar="COMMAND")
 
     def add(name: str, handler: Handler, help_: str) -> argparse.ArgumentParser:
@@ -49,6 +62,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     for register in REGISTER:
         register(add)
+    completion.register(add, p)  # last: its script is made from the whole parser
     return p
 
 

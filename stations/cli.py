@@ -1,5 +1,5 @@
-"""``liansuo stations``, ``liansuo check STATION [--format text|json]``, ``liansuo schema`` and ``liansuo generate hub
---turnouts N --tracks M [-o FILE]``: the station files."""
+"""``liansuo stations``, ``liansuo check STATION [--format text|json]`` and ``liansuo generate hub --turnouts N
+--tracks M [-o FILE]``: the station files (``liansuo schema`` is in ``cli/schemas.py``, with the other kinds)."""
 
 from __future__ import annotations
 
@@ -10,7 +10,6 @@ from collections.abc import Callable
 
 from .library import bundled, describe
 from .loader import load
-from .schema import StationFile
 from .source import StationError
 from .summary import summarise, summary_text
 
@@ -48,14 +47,6 @@ def cmd_check(args: argparse.Namespace) -> int:
     return 0
 
 
-def cmd_schema(args: argparse.Namespace) -> int:
-    schema = StationFile.model_json_schema(by_alias=True)
-    schema["$schema"] = "https://json-schema.org/draft/2020-12/schema"
-    schema["title"] = "liansuo station file"
-    print(json.dumps(schema, ensure_ascii=False, indent=2))
-    return 0
-
-
 def cmd_generate(args: argparse.Namespace) -> int:
     """A generated hub station file (the benchmark's), on stdout or in ``-o FILE``."""
     from pathlib import Path
@@ -84,7 +75,6 @@ def register(add: Add) -> None:
     sp = add("check", cmd_check, "validate a station file and summarise it")
     sp.add_argument("station", help="bundled station name or path to a station YAML file")
     sp.add_argument("--format", choices=("text", "json"), default="text")
-    add("schema", cmd_schema, "print the JSON Schema of the station format")
     sp = add("generate", cmd_generate, "write a generated station file (a hub of any size, for stress tests)")
     sp.add_argument("kind", choices=("hub",), help="what to generate: 'hub', a double-ended yard of parallel tracks")
     sp.add_argument("--turnouts", type=_positive, required=True, metavar="N", help="turnouts in the hub")
