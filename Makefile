@@ -8,11 +8,15 @@ STAMP := $(VENV)/.installed
 
 # Reinstall only when pyproject.toml changed since the last install. The sumo extra (libsumo, eclipse-sumo, about
 # 230 MB) is installed too where it can be; where it cannot, the SUMO engine's tests skip and say why.
+# QUIET_BUILD silences setuptools' one notice on an editable install of a flat layout ("be careful with folders in
+# your working directory with the same name as your package": liansuo/ is that folder, by design); every other
+# warning of the build still shows.
+QUIET_BUILD := PYTHONWARNINGS="ignore:Editable installation"
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
-	$(BIN)/python -m pip install --quiet -e '.[test]'
-	$(BIN)/python -m pip install --quiet -e '.[sumo]' > $(VENV)/sumo-install.log 2>&1 \
+	$(QUIET_BUILD) $(BIN)/python -m pip install --quiet -e '.[test]'
+	$(QUIET_BUILD) $(BIN)/python -m pip install --quiet -e '.[sumo]' > $(VENV)/sumo-install.log 2>&1 \
 		|| echo "notice: the sumo extra (libsumo, eclipse-sumo) could not be installed, the SUMO engine tests will skip (see $(VENV)/sumo-install.log)"
 	touch $(STAMP)
 

@@ -13,11 +13,13 @@ from collections.abc import Callable, Sequence
 
 from liansuo.bench import cli as bench
 from liansuo.circuits import zpwcli
+from liansuo.cli import completion, schemas
 from liansuo.interlocking import cli as interlocking
 from liansuo.proving import cli as proving
 from liansuo.proving import mutation, soakcli
 from liansuo.proving.verify import cli as verify
 from liansuo.stations import cli as stations
+from liansuo.stations.jsonreport import version
 from liansuo.tui import cli as tui
 
 Handler = Callable[[argparse.Namespace], int]
@@ -25,7 +27,8 @@ Add = Callable[[str, Handler, str], argparse.ArgumentParser]
 
 # in the order of the help: the station, its table and track circuits, proving it, timing it, the console
 REGISTER: tuple[Callable[[Add], None], ...] = (
-    stations.register,  # stations, check, schema
+    stations.register,  # stations, check, generate
+    schemas.register,  # schema
     interlocking.register,  # table
     zpwcli.register,  # zpw
     proving.register_run,  # run
@@ -41,6 +44,7 @@ REGISTER: tuple[Callable[[Add], None], ...] = (
 
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="liansuo", description="Station signalling and interlocking simulator (联锁)")
+    p.add_argument("--version", action="version", version=f"liansuo {version()}")
     sub = p.add_subparsers(dest="command", metavar="COMMAND")
 
     def add(name: str, handler: Handler, help_: str) -> argparse.ArgumentParser:
@@ -50,6 +54,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     for register in REGISTER:
         register(add)
+    completion.register(add, p)  # last: its script is made from the whole parser
     return p
 
 

@@ -20,11 +20,13 @@ from pathlib import Path
 from typing import Any
 
 from liansuo.simulation.sim import LANGUAGE, Simulation
-from liansuo.simulation.timeparse import parse_duration
 from liansuo.stations.filekind import read_source
 from liansuo.stations.loader import load
 from liansuo.stations.source import Diagnostic, StationError
 from liansuo.stations.station import Station
+from liansuo.stations.validation import validate
+
+from .fileschemas import ScenarioFile
 
 
 @dataclass
@@ -37,34 +39,18 @@ class Scenario:
 
 
 def parse_scenario(path: Path) -> Scenario:
+    """Read and check a scenario (:class:`~.fileschemas.ScenarioFile`, then every step a command of the language);
+    :class:`StationError` with FILE:LINE:COLUMN diagnostics when malformed, or when it is a file of another kind."""
     src = read_source(path, "scenario", "give the path of a scenario file (see examples/scenarios/)")
     data = src.data
-    errors: list[Diagnostic] = []
     if not isinstance(data, dict):
         raise StationError([src.diagnostic((), "a scenario is a mapping with 'station:' and 'steps:'", "")])
-    for key in data:
-        if key not in ("station", "description", "steps", "until"):
-            errors.append(src.diagnostic((key,), f"unknown key '{key}'", "a scenario has station, description, "
-                                         "steps and until", at_key=True))
-    if not isinstance(data.get("station"), str):
-        errors.append(src.diagnostic(("station",) if "station" in data else (), "missing or invalid 'station:'",
-                                     "name a bundled station or a station file"))
-    steps_raw = data.get("steps")
-    steps: list[tuple[str, int]] = []
-    if not isinstance(steps_raw, list) or not steps_raw:
-        errors.append(src.diagnostic(("steps",) if "steps" in data else (), "'steps:' must be a list of commands",
-                                     ""))
-    else:
-        steps = LANGUAGE.read_steps(src, ("steps",), steps_raw, errors)
-    until = None
-    if "until" in data:
-        try:
-            until = parse_duration(str(data["until"]))
-        except ValueError as exc:
-            errors.append(src.diagnostic(("until",), str(exc), ""))
-    if errors:
+    errors: list[Diagnostic] = []
+    steps = LANGUAGE.read_steps(src, ("steps",), data.get("steps"), errors)
+    model = validate(src, ScenarioFile, errors, "scenario", "docs/trains.md")
+    if errors or model is None:
         raise StationError(errors)
-    return Scenario(str(path), str(data["station"]), str(data.get("description", "")), steps, until)
+    return Scenario(str(path), model.station, str(model.description), steps, model.until)
 
 
 @dataclass

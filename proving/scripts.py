@@ -29,7 +29,9 @@ from liansuo.stations.filekind import read_source
 from liansuo.stations.loader import load
 from liansuo.stations.source import Diagnostic, StationError
 from liansuo.stations.station import Station
+from liansuo.stations.validation import validate
 
+from .fileschemas import ScriptFile
 from .oracle import Watch
 
 
@@ -87,45 +89,23 @@ class Unrunnable:
 
 
 def parse_script(path: Path) -> Script:
+    """Read and check a test script (:class:`~.fileschemas.ScriptFile`, then every step a command of the language);
+    :class:`StationError` with FILE:LINE:COLUMN diagnostics when malformed, or when it is a file of another kind."""
     src = read_source(path, "script", "give the path of a YAML test script (see examples/scripts/)")
-    errors: list[Diagnostic] = []
     data = src.data
     if not isinstance(data, dict):
         raise StationError([src.diagnostic((), "a test script is a mapping with 'station:' and 'tests:'",
                                            "see examples/ for scripts")])
-    for key in data:
-        if key not in ("station", "tests", "cycle_ms", "safety"):
-            errors.append(src.diagnostic((key,), f"unknown key '{key}'", "a script has station, tests and "
-                                         "optionally cycle_ms and safety", at_key=True))
-    station = data.get("station")
-    if not isinstance(station, str):
-        errors.append(src.diagnostic(("station",) if "station" in data else (), "missing or invalid 'station:'",
-                                     "name a bundled station or a station file path"))
+    errors: list[Diagnostic] = []
     tests_raw = data.get("tests")
-    tests: list[ScriptTest] = []
-    if not isinstance(tests_raw, list) or not tests_raw:
-        errors.append(src.diagnostic(("tests",) if "tests" in data else (), "'tests:' must be a non-empty list", ""))
-        tests_raw = []
-    for i, t in enumerate(tests_raw):
-        if not isinstance(t, dict) or not isinstance(t.get("name"), str) or not isinstance(t.get("steps"), list):
-            errors.append(src.diagnostic(("tests", i), "each test needs 'name:' and a list of 'steps:'", ""))
-            continue
-        for key in t:
-            if key not in ("name", "steps"):
-                errors.append(src.diagnostic(("tests", i, key), f"unknown key '{key}' in a test", "", at_key=True))
-        steps = [Step(s, line) for s, line in LANGUAGE.read_steps(src, ("tests", i, "steps"), t["steps"], errors)]
-        tests.append(ScriptTest(t["name"], steps, src.mark(("tests", i)).line))
-    cycle_ms = data.get("cycle_ms", 250)
-    if not isinstance(cycle_ms, int | float) or isinstance(cycle_ms, bool) or not 10 <= cycle_ms <= 2000:
-        errors.append(src.diagnostic(("cycle_ms",), "cycle_ms must be a number from 10 to 2000", ""))
-        cycle_ms = 250
-    safety = data.get("safety", False)
-    if not isinstance(safety, bool):
-        errors.append(src.diagnostic(("safety",), "safety must be true or false", ""))
-        safety = False
-    if errors:
+    steps = [LANGUAGE.read_steps(src, ("tests", i, "steps"), t.get("steps") if isinstance(t, dict) else None, errors)
+             for i, t in enumerate(tests_raw if isinstance(tests_raw, list) else [])]
+    model = validate(src, ScriptFile, errors, "script", "docs/commands.md")
+    if errors or model is None:
         raise StationError(errors)
-    return Script(str(path), str(station), tests, cycle_ms / 1000.0, safety)
+    tests = [ScriptTest(t.name, [Step(text, line) for text, line in lines], src.mark(("tests", i)).line)
+             for i, (t, lines) in enumerate(zip(model.tests, steps, strict=True))]
+    return Script(str(path), model.station, tests, model.cycle_ms / 1000.0, model.safety)
 
 
 def _resolve_station(script: Script, src_dir: Path) -> Station:

@@ -24,11 +24,10 @@ from pathlib import Path
 from liansuo.stations.filekind import read_source
 from liansuo.stations.library import bundled
 from liansuo.stations.source import Diagnostic, StationError
+from liansuo.stations.validation import validate
 
+from .exerciseschema import ExerciseFile, Goal
 from .sim import LANGUAGE, Simulation
-
-KEYS = ("title", "station", "description", "setup", "goal")
-GOAL_KEYS = ("description", "expect")
 
 
 @dataclass
@@ -63,44 +62,17 @@ def parse_exercise(path: str | Path) -> Exercise:
     names = ", ".join(p.stem for p in bundled_exercises())
     src = read_source(given, "exercise", f"give the path of an exercise file, or a bundled exercise: {names}")
     data = src.data
-    errors: list[Diagnostic] = []
     if not isinstance(data, dict):
         raise StationError([src.diagnostic((), "an exercise is a mapping with title, station, setup and goal", "")])
-    for key in data:
-        if key not in KEYS:
-            errors.append(src.diagnostic((key,), f"unknown key '{key}'", f"an exercise has {', '.join(KEYS)}",
-                                         at_key=True))
-    for key in ("title", "station"):
-        if not isinstance(data.get(key), str) or not data.get(key):
-            errors.append(src.diagnostic((key,) if key in data else (), f"missing or invalid '{key}:'", ""))
-    setup: list[str] = []
-    raw = data.get("setup", [])
-    if not isinstance(raw, list):
-        errors.append(src.diagnostic(("setup",), "'setup:' is a list of commands", ""))
-        raw = []
-    setup = [s for s, _ in LANGUAGE.read_steps(src, ("setup",), raw, errors)]
-    goal = data.get("goal", {}) or {}
-    expect: list[str] = []
-    if not isinstance(goal, dict):
-        errors.append(src.diagnostic(("goal",), "'goal:' is a mapping with description and expect", ""))
-        goal = {}
-    for key in goal:
-        if key not in GOAL_KEYS:
-            errors.append(src.diagnostic(("goal", key), f"unknown key '{key}'", "a goal has description and expect",
-                                         at_key=True))
-    lines = goal.get("expect", [])
-    if not isinstance(lines, list):
-        errors.append(src.diagnostic(("goal", "expect"), "'expect:' is a list of expect lines", ""))
-        lines = []
-    for i, line in enumerate(lines):
-        if not isinstance(line, str):
-            errors.append(src.diagnostic(("goal", "expect", i), "an expect line is text", ""))
-            continue
-        expect.append(line if line.strip().startswith("expect") else f"expect {line.strip()}")
-    if errors:
+    errors: list[Diagnostic] = []
+    setup = [s for s, _ in LANGUAGE.read_steps(src, ("setup",), data.get("setup"), errors)]
+    model = validate(src, ExerciseFile, errors, "exercise", "docs/console.md")
+    if errors or model is None:
         raise StationError(errors)
-    return Exercise(str(path), str(data["title"]), str(data["station"]), str(data.get("description", "")).strip(),
-                    setup, str(goal.get("description", "")).strip(), expect)
+    goal = model.goal or Goal()
+    expect = [line if line.strip().startswith("expect") else f"expect {line.strip()}" for line in goal.expect]
+    return Exercise(str(path), model.title, model.station, str(model.description).strip(), setup,
+                    str(goal.description).strip(), expect)
 
 
 def check_goal(sim: Simulation, ex: Exercise) -> GoalCheck:

@@ -1,10 +1,10 @@
-"""``liansuo stations [--format text|json]``, ``liansuo check STATION [--format text|json]``, ``liansuo schema`` and
-``liansuo generate hub --turnouts N --tracks M [-o FILE]``: the station files."""
+"""``liansuo stations [--format text|json]``, ``liansuo check STATION [--format text|json]`` and ``liansuo generate
+hub --turnouts N --tracks M [-o FILE]``: the station files (``liansuo schema`` is in ``cli/schemas.py``, with the
+other kinds)."""
 
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 from collections.abc import Callable
 
@@ -14,7 +14,6 @@ from .fit import fit
 from .jsonreport import print_report
 from .library import bundled, describe
 from .loader import load
-from .schema import StationFile
 from .source import StationError
 from .summary import summarise, summary_text
 
@@ -48,14 +47,6 @@ def cmd_check(args: argparse.Namespace) -> int:
         print_report("check", True, summarise(station))
     else:
         print(summary_text(station))
-    return 0
-
-
-def cmd_schema(args: argparse.Namespace) -> int:
-    schema = StationFile.model_json_schema(by_alias=True)
-    schema["$schema"] = "https://json-schema.org/draft/2020-12/schema"
-    schema["title"] = "liansuo station file"
-    print(json.dumps(schema, ensure_ascii=False, indent=2))
     return 0
 
 
@@ -93,7 +84,6 @@ def register(add: Add) -> None:
     sp = add("check", cmd_check, "validate a station file and summarise it")
     sp.add_argument("station", help="bundled station name or path to a station YAML file")
     sp.add_argument("--format", choices=FORMATS, default="text", help="text (default) or json")
-    add("schema", cmd_schema, "print the JSON Schema of the station format")
     sp = add("generate", cmd_generate, "write a generated station file (a hub of any size, for stress tests)")
     sp.add_argument("kind", choices=("hub",), help="what to generate: 'hub', a double-ended yard of parallel tracks")
     sp.add_argument("--turnouts", type=positive_int, required=True, metavar="N", help="turnouts in the hub")

@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
-from typing import Any
 
 from pydantic import ValidationError
 
@@ -21,62 +20,9 @@ from .filekind import check_kind, read_source
 from .library import resolve
 from .rules import design_warnings
 from .schema import StationFile
-from .source import Diagnostic, Source, StationError, read_yaml
+from .source import Source, StationError, read_yaml
 from .station import Station
-
-_HINTS = {
-    "extra_forbidden": "remove it, or check its spelling against 'liansuo schema' and docs/station-format.md",
-    "missing": "add this key; docs/station-format.md lists what each item needs",
-    "enum": "use one of the values listed",
-    "literal_error": "use one of the values listed",
-    "string_type": "write a text value",
-    "float_type": "write a number of metres",
-    "int_type": "write a whole number",
-    "bool_type": "write true or false",
-    "list_type": "write a list ('- item' lines)",
-    "model_type": "write a mapping ('key: value' lines)",
-    "too_short": "add items: the message says how many the list needs",
-    "too_long": "remove items: the message says how many the list takes",
-    "string_too_short": "write a non-empty text",
-    "int_from_float": "write a whole number",
-    "greater_than": "write a larger number",
-    "greater_than_equal": "write a larger number",
-    "less_than": "write a smaller number",
-    "less_than_equal": "write a smaller number",
-    "finite_number": "write an ordinary number (not .nan or .inf)",
-}
-_DEFAULT_HINT = "docs/station-format.md explains what this key takes"
-
-
-def _describe(err: Any) -> str:
-    kind = err["type"]
-    loc = err["loc"]
-    where = ".".join(str(p) for p in loc if p != "__root__")
-    if kind == "extra_forbidden":
-        return f"unknown key '{loc[-1]}'"
-    if kind == "missing":
-        return f"missing key '{loc[-1]}'"
-    msg = str(err["msg"])
-    if msg.startswith("Value error, "):
-        msg = msg[len("Value error, "):]
-    value = err.get("input")
-    shown = repr(value) if not isinstance(value, dict | list) else type(value).__name__
-    if len(shown) > 40:
-        shown = shown[:37] + "..."
-    return f"{where}: {msg} (got {shown})"
-
-
-def _schema_diagnostics(src: Source, exc: ValidationError) -> list[Diagnostic]:
-    out = []
-    for err in exc.errors():
-        loc = tuple(p for p in err["loc"] if not (isinstance(p, str) and p.startswith("function-")))
-        # pydantic reports the alias for 'from'/'to' tracks; marks are stored under the YAML key, which matches.
-        hint = _HINTS.get(err["type"], _DEFAULT_HINT)
-        at_key = err["type"] == "extra_forbidden"
-        if err["type"] == "missing":
-            loc = loc[:-1]
-        out.append(src.diagnostic(loc, _describe(err), hint, at_key=at_key))
-    return out
+from .validation import schema_diagnostics
 
 
 def parse_source(src: Source, rules: RuleSet | None = None) -> Station:
@@ -88,7 +34,7 @@ def parse_source(src: Source, rules: RuleSet | None = None) -> Station:
         # JSON mode keeps strictness (no "1" -> 1) while accepting enum values written as text
         model = StationFile.model_validate_json(json.dumps(src.data, default=str), by_alias=True)
     except ValidationError as exc:
-        raise StationError(_schema_diagnostics(src, exc)) from None
+        raise StationError(schema_diagnostics(src, exc)) from None
     errors = double_slip_errors(model, src)
     if errors:
         raise StationError(errors)

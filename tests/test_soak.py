@@ -78,4 +78,5 @@ def test_safety_scripts_pass_on_the_real_interlocking(tmp_path: Path, capsys: py
     assert main(["test", str(f)]) == 0
     f.write_text(f.read_text(encoding="utf-8").replace("safety: true", "safety: 1"), encoding="utf-8")
     assert main(["test", str(f)]) == 3  # a malformed script is a bad input file
-    assert "safety must be true or false" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "safety: Input should be a valid boolean (got 1)" in err and "hint: write true or false" in err

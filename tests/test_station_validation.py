@@ -113,13 +113,13 @@ class Broken:
 BROKEN = [
     # --- YAML itself
     Broken("yaml syntax: unclosed flow mapping", edit(BASE, ("at: 0}\n", "at: 0\n")), "YAML syntax error",
-           "{id: SB, kind", ("did not find expected", "line 15")),
+           "{id: SB, kind", ("did not find expected", "line 16")),
     Broken("yaml syntax: colon in a value", edit(BASE, ("line: double\n", "line: double: single\n")),
            "YAML syntax error", "double^: single", ("mapping values are not allowed",)),
     Broken("yaml syntax: tab indentation", edit(BASE, ("  - {id: IAG", "\t- {id: IAG")), "YAML syntax error",
            "\t- {id: IAG", ("tab", "spaces")),
     Broken("yaml syntax: unclosed quote", edit(BASE, ("{zh: 最小站", '{zh: "最小站')), "YAML syntax error",
-           '"^1", at: 250', ("flow mapping at line 9",)),
+           '"^1", at: 250', ("flow mapping at line 10",)),
     Broken("empty file", "", "the file is empty", None, ("id:",)),
     Broken("file of comments only", "# nothing here\n", "the file is empty", None),
     Broken("not a mapping", "- a\n- b\n", "a station file is a mapping", None),

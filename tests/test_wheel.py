@@ -4,8 +4,9 @@ environment outside the checkout, and run from another folder with no PYTHONPATH
 The rest of the suite runs against the editable install, where the checkout itself is on ``sys.path``: a data file
 missing from ``[tool.setuptools.package-data]``, a layer folder without ``__init__.py`` or a top-level package that
 should not be installed would all pass there and break ``pip install liansuo``. Here the installed ``liansuo`` runs
-``verify``, a route-test script, ``table``, the Python API, a bundled exercise, the console headless and the pytest
-plugin; a failure names the command that failed, its folder, exit status, stdout and stderr.
+``verify``, a route-test script, ``table``, the Python API, a bundled exercise, the console headless, the pytest
+plugin, ``--version``, ``completion`` and the shipped JSON Schemas; a failure names the command that failed, its
+folder, exit status, stdout and stderr.
 
 One build and one virtual environment serve every test of a run (a session fixture; some 20 s of CPU in all). Select
 with ``pytest -m wheel``, leave out with ``-m 'not wheel'``. The only skip: no package index is reachable and pip's
@@ -15,6 +16,7 @@ cache lacks a requirement, so the wheel can be neither built nor installed.
 from __future__ import annotations
 
 import os
+import re
 import shlex
 import shutil
 import subprocess
@@ -154,6 +156,7 @@ class Installed:
     venv: Path
     work: Path
     env: dict[str, str] = field(repr=False)
+    build_output: str = field(repr=False, default="")  # what 'pip wheel' printed
 
     @property
     def python(self) -> str:
@@ -217,12 +220,12 @@ def unreachable(requirements: list[str], tmp: Path, *options: str) -> str:
 
 
 def build_or_skip(what: str, args: Sequence[str | Path], cwd: Path, env: dict[str, str], requirements: list[str],
-                  tmp: Path) -> None:
-    """Run a step that needs the package index; skip only when pip can neither reach an index nor find the
-    requirements in its cache, fail on anything else."""
+                  tmp: Path) -> subprocess.CompletedProcess[str]:
+    """Run a step that needs the package index and return what it printed; skip only when pip can neither reach an
+    index nor find the requirements in its cache, fail on anything else."""
     proc = run(args, cwd, env)
     if proc.returncode == 0:
-        return
+        return proc
     why = unreachable(requirements, tmp)
     if not why:
         pytest.fail(f"wheel check: {what} failed (pip can get {', '.join(requirements)}, so the failure is the "
@@ -249,15 +252,15 @@ def install(tmp: Path) -> Installed:
     project = tomllib.loads((ROOT / "pyproject.toml").read_text("utf-8"))
     source = copy_source(tmp / "source")
     dist = tmp / "dist"
-    build_or_skip("built", [sys.executable, "-m", "pip", "wheel", "--no-deps", "--wheel-dir", dist, source], tmp,
-                  clean_env(), list(project["build-system"]["requires"]), tmp)
+    built = build_or_skip("built", [sys.executable, "-m", "pip", "wheel", "--no-deps", "--wheel-dir", dist, source],
+                          tmp, clean_env(), list(project["build-system"]["requires"]), tmp)
     wheels = sorted(dist.glob("liansuo-*.whl"))
     assert len(wheels) == 1, f"pip wheel left {[w.name for w in dist.iterdir()]} in {dist}, expected one liansuo wheel"
     venv = tmp / "venv"
     # without pip of its own: this pip installs into it (--python), which saves seconds and changes nothing installed
     must("creating a fresh virtual environment", [sys.executable, "-m", "venv", "--without-pip", venv], tmp,
          clean_env())
-    inst = Installed(wheels[0], source, venv, tmp / "work", clean_env(venv))
+    inst = Installed(wheels[0], source, venv, tmp / "work", clean_env(venv), built.stdout + built.stderr)
     inst.work.mkdir()
     # pytest too, for the wheel's pytest11 entry point; bytecode is written as modules are first imported
     build_or_skip("installed", [*inst.pip, "install", "--no-compile", "--no-warn-script-location", inst.wheel,
@@ -282,6 +285,13 @@ def test_the_wheel_holds_the_package_liansuo_only_and_every_file_of_it(installed
     assert roots == {"liansuo"}, f"pip show -f liansuo: the install adds the top-level names {sorted(roots)}, " \
                                  f"expected only liansuo/:\n{out}"
     assert any(f.endswith(f"{BIN}/liansuo") for f in files), f"no liansuo console script installed:\n{out}"
+
+
+def test_the_build_prints_no_warning(installed: Installed) -> None:
+    """Setuptools' deprecation warnings (a license given as a table, say) are printed by 'pip wheel' and by the first
+    'make test'; the project's metadata must give none."""
+    warnings = [line for line in installed.build_output.splitlines() if re.search(r"warning|deprecat", line, re.I)]
+    assert not warnings, "pip wheel printed warnings:\n" + installed.build_output
 
 
 def test_verify_passes_on_the_bundled_station(installed: Installed) -> None:
@@ -350,3 +360,36 @@ def test_the_pytest_plugin_loads_light_and_runs_scripts(installed: Installed) ->
     out = must("pytest on a route-test script", [installed.python, "-m", "pytest", "-p", "no:cacheprovider",
                                                  "test_routes.yaml"], installed.work, installed.env)
     assert "2 passed" in out.strip().splitlines()[-1], f"pytest test_routes.yaml:\n{out}"
+
+
+SCHEMA_FILES_CHECK = """\
+import json
+from importlib.resources import files
+from pathlib import Path
+
+root = Path(str(files("liansuo")))
+for kind in ("station", "script", "scenario", "exercise"):
+    path = root / "schemas" / f"{kind}-1.json"
+    print(kind, json.loads(path.read_text(encoding="utf-8"))["$id"], path)
+example = root / "examples" / "stations" / "minimal.yaml"
+modeline = example.read_text(encoding="utf-8").splitlines()[0].split("$schema=", 1)[1]
+print("modeline", (example.parent / modeline).resolve() == (root / "schemas" / "station-1.json").resolve())
+"""
+
+
+def test_version_completion_and_the_shipped_schemas(installed: Installed) -> None:
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text("utf-8"))
+    out = must("liansuo --version", [installed.liansuo, "--version"], installed.work, installed.env)
+    assert out == f"liansuo {project['project']['version']}\n", f"liansuo --version: {out!r}"
+    out = must("liansuo completion bash", [installed.liansuo, "completion", "bash"], installed.work, installed.env)
+    assert "complete " in out and "liansuo" in out, f"liansuo completion bash:\n{out}"
+    out = must("the shipped schemas (python -c ...)", [installed.python, "-c", SCHEMA_FILES_CHECK], installed.work,
+               installed.env)
+    lines = dict(line.split(" ", 1) for line in out.splitlines())
+    assert lines["modeline"] == "True", f"the example's modeline does not name the installed schema:\n{out}"
+    for kind in ("station", "script", "scenario", "exercise"):
+        schema_id, path = lines[kind].split(" ", 1)
+        assert schema_id == f"https://liansuo.dev/schema/{kind}-1.json", out
+        assert Path(path).resolve().is_relative_to(installed.venv.resolve()), f"{kind} schema not installed: {path}"
+        printed = must(f"liansuo schema {kind}", [installed.liansuo, "schema", kind], installed.work, installed.env)
+        assert printed == Path(path).read_text(encoding="utf-8"), f"liansuo schema {kind} differs from {path}"
