@@ -1,16 +1,16 @@
 """The trackside field: every piece of equipment whose relays the interlocking reads.
 
 ``Field.step(dt, commands)`` moves time on: switch machines turn, doors open and close, the USU flasher flashes,
-lamps light as commanded, and track circuits follow the wheelsets standing on them (``set_axles``) and the
-teaching panel's switch K (``occupy`` / ``vacate``). Relay states are read through the ``track_up``,
-``indication``, ``lamp_proven``, ``flasher_ok`` and ``doors`` methods; ``take_changes`` says what changed since it
-was last called, so the one reading them copies only that. Faults are injected with ``inject`` and removed with
-``repair`` (``circuits.faults`` parses them).
+lamps light as commanded, and track circuits follow the wheelsets standing on them (``set_axles``: loose wheelsets
+and trains, :mod:`.shunts`) and the teaching panel's switch K (``occupy`` / ``vacate``). Relay states are read
+through the ``track_up``, ``indication``, ``lamp_proven``, ``flasher_ok`` and ``doors`` methods; ``take_changes``
+says what changed since it was last called, so the one reading them copies only that. Faults are injected with
+``inject`` and removed with ``repair`` (``circuits.faults`` parses them).
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 
 from liansuo.rules import RuleSet, load_rules
@@ -22,6 +22,7 @@ from .flasher import ElectronicFlasher, RelayFlasher
 from .lamps import SignalLamps
 from .machines import SwitchMachine
 from .railgeometry import Axle, geometry_of
+from .shunts import OnTrack, SectionShunts, Shunt, WheelsetGroup, changed_sections
 from .trackcircuits import SectionCircuit, build_circuit
 
 
@@ -67,15 +68,19 @@ class Field:
                       for p in station.model.platforms for d in p.screen_doors}
         self.faults: dict[tuple[str, str], Fault] = {}
         self.axles: list[Axle] = []
-        self.shunts: dict[str, list[tuple[float, float]]] = {}
+        self.on_track = OnTrack()  # every wheelset on the track, as the field was last told (``set_axles``)
+        self._shunts = {s: SectionShunts(self.on_track, s) for s in station.sections}
+        self._settled: set[str] = set()  # sections whose circuits are down by a standard shunt (``shunted_down``)
+        self._listed: dict[str, list[Shunt]] = {}  # the shunts each other section was last evaluated with
         self.cab_codes: dict[str, str | None] = {}
         self._driven: set[str] = set()  # machines with a drive command outstanding
         self._moving: set[str] = set()
         self.stamp = 0  # counts the batches of changes taken: what reads the field can tell when nothing changed
         self._changes = Changes(set(station.sections), set(station.turnouts), set(station.signals),
                                 set(self.doors))
-        for c in self.circuits.values():
+        for sec, c in self.circuits.items():
             c.update([])
+            self._listed[sec] = []
 
     # ---- occupancy ------------------------------------------------------------------------------------------
     def occupy(self, section: str) -> None:
@@ -86,24 +91,40 @@ class Field:
         self.circuits[section].k_switch = False
         self._reevaluate(section)
 
-    def set_axles(self, axles: Iterable[Axle], more: dict[str, list[tuple[float, float]]] | None = None) -> None:
-        """Where every wheelset stands now (and ``more`` shunts already worked out by section, e.g. a train's);
-        sections whose shunts changed are re-evaluated."""
+    def set_axles(self, axles: Iterable[Axle], groups: Mapping[str, WheelsetGroup] | None = None) -> None:
+        """Where every wheelset stands now: loose ``axles``, and ``groups`` of wheelsets moving together (trains, by
+        name). Sections whose shunts changed are re-evaluated, except that a circuit down by a standard shunt is
+        not re-evaluated while its groups' wheelsets only move on it (it stays down by design)."""
         self.axles = list(axles)
-        shunts = self.geometry.shunts_of(self.axles)
-        for sec, lst in (more or {}).items():
-            shunts.setdefault(sec, []).extend(lst)
-        touched = set(shunts) | set(self.shunts)
-        old = self.shunts
-        self.shunts = shunts
+        loose = self.geometry.shunts_of(self.axles)
+        groups = dict(groups or {})
+        touched = changed_sections(self.on_track, loose, groups, self._settled)
+        self.on_track.loose, self.on_track.groups = loose, groups
         for sec in touched:
-            if old.get(sec) != shunts.get(sec):
-                self._reevaluate(sec)
+            self._reevaluate(sec, if_changed=True)
 
-    def _reevaluate(self, section: str) -> None:
+    def shunts_on(self, section: str) -> list[Shunt]:
+        """Every shunt on ``section`` now: (distance from its low end, ohm)."""
+        return self.on_track.listed(section)
+
+    def _reevaluate(self, section: str, *, if_changed: bool = False) -> None:
+        """Update the section's circuit with its shunts now; ``if_changed``: only if they differ from the ones it
+        was last evaluated with in full (a circuit down by a standard shunt is updated again, which leaves it
+        down unless its shunts are gone)."""
         c = self.circuits[section]
+        shunts = self._shunts[section]
+        last = self._listed.get(section)
+        if if_changed and last is not None and (shunts.listed() == last if last
+                                                else not self.on_track.occupies(section)):
+            return  # the same shunts as when last evaluated (none: without listing a train's)
         before = c.up
-        c.update(self.shunts.get(section, []))
+        c.update(shunts)
+        if c.shunted_down:
+            self._settled.add(section)
+            self._listed.pop(section, None)
+        else:
+            self._settled.discard(section)
+            self._listed[section] = shunts.listed()
         if c.up != before:
             self._changes.tracks.add(section)
 

@@ -1,11 +1,13 @@
 """One live track circuit per section: the physical model of its type behind one small interface.
 
 ``SectionCircuit.update(shunts)`` re-evaluates the model when the wheelsets on the section or its faults change and
-returns the track relay (GJ) state with the model's hysteresis. The teaching base's switch K (``occupy``) forces the
-relay down. Faults a section can carry: broken rail, poor shunt (wheelsets shunt through a higher resistance), low
-ballast, failed insulation (at an insulated joint or a switch machine), and on ZPW-2000A compensation capacitors.
-A section of ``type: axle_counter`` has an axle counter (:mod:`.axlecounter`) instead: it counts wheelsets, so those
-faults do not touch it; its own fault is a miscount, and its count is reset by the operator (计轴复零).
+returns the track relay (GJ) state with the model's hysteresis. The shunts are a list, or the field's live view of
+the section (:mod:`.shunts`), listed only when the model must be solved. The teaching base's switch K (``occupy``)
+forces the relay down. Faults a section can carry: broken rail, poor shunt (wheelsets shunt through a higher
+resistance), low ballast, failed insulation (at an insulated joint or a switch machine), and on ZPW-2000A
+compensation capacitors. A section of ``type: axle_counter`` has an axle counter (:mod:`.axlecounter`) instead: it
+counts wheelsets, so those faults do not touch it; its own fault is a miscount, and its count is reset by the
+operator (计轴复零).
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ from liansuo.stations.station import Station
 
 from .axlecounter import AxleCounter
 from .phase25hz import Phase25HzCircuit, Phase25HzFaults, adjusted_params
+from .shunts import Listed, Shunt, Shunts
 
 
 @dataclass
@@ -48,7 +51,7 @@ class SectionCircuit:
         self.up = False  # fail-safe until first evaluated
         self._voltage = 0.0  # V for 25 Hz, mV for ZPW-2000A
         self._cab_current_mA: float | None = None
-        self._stale: Sequence[tuple[float, float]] | None = None  # shunts not yet solved for (see ``update``)
+        self._shunted: Shunts | None = None  # while down by a standard shunt: the shunts, solved only if asked
         self._inside = 0  # wheelsets on the section at the last update (what an axle counter counts)
         # every model is adjusted so that one standard shunt anywhere drops its relay (25 Hz: residual <= 7.4 V
         # with 0.06 ohm, below the relay's drop level; ZPW-2000A: < 153 mV with 0.15 ohm), as their tests assert
@@ -57,19 +60,24 @@ class SectionCircuit:
     @property
     def voltage(self) -> float:
         """Relay-end voltage: V for 25 Hz, mV for ZPW-2000A."""
-        self._solve_stale()
+        self._solve_shunted()
         return self._voltage
 
     @property
     def cab_current_mA(self) -> float | None:
-        self._solve_stale()
+        self._solve_shunted()
         return self._cab_current_mA
 
-    def _solve_stale(self) -> None:
-        if self._stale is not None:
-            shunts, self._stale = self._stale, None
+    @property
+    def shunted_down(self) -> bool:
+        """Down by design: a healthy track circuit with a standard shunt on it. It stays down while the shunts
+        only move, and needs to be updated again only when it may lose its last standard shunt or gets a fault."""
+        return self._shunted is not None and not self.faults.any()
+
+    def _solve_shunted(self) -> None:
+        if self._shunted is not None:
             up = self.up
-            self._evaluate(shunts)
+            self._evaluate(self._shunted.listed())
             self.up = up
 
     @property
@@ -85,22 +93,27 @@ class SectionCircuit:
     @property
     def inside(self) -> int:
         """Wheelsets on the section at the last update."""
-        return self._inside
+        return self._shunted.count() if self._shunted is not None else self._inside
 
-    def update(self, shunts: Sequence[tuple[float, float]]) -> bool:
+    def update(self, shunts: Sequence[Shunt] | Shunts) -> bool:
+        """The relay with ``shunts`` on the section: a list, or a live view (kept while the relay is down by a
+        standard shunt, so the voltage read later is the one of the shunts then on the section)."""
+        if not isinstance(shunts, Shunts):
+            shunts = Listed(list(shunts))
         f = self.faults
-        self._inside = len(shunts)
+        self._shunted = None
         if isinstance(self.model, AxleCounter):
+            self._inside = shunts.count()
             self.up = self.model.clear(self._inside) and not self.k_switch
             return self.up
-        std = self.standard_shunt_ohm
-        if shunts and not f.any() and any(r <= std for _, r in shunts):
+        if not f.any() and shunts.standard(self.standard_shunt_ohm):
             # a healthy circuit with a standard (or better) shunt on it: down by design; solve only if asked
-            self._stale = list(shunts)
+            self._shunted = shunts
             self.up = False
             return self.up
-        self._stale = None
-        self._evaluate(shunts)
+        listed = shunts.listed()
+        self._inside = len(listed)
+        self._evaluate(listed)
         if self.k_switch:
             self.up = False
         return self.up

@@ -113,7 +113,7 @@ class World:
 
     def update_axles(self) -> None:
         """Tell the field where every wheelset stands: trains and parked wheelsets."""
-        self.field.set_axles([a for group in self.parked.values() for a in group], self.fleet.shunts())
+        self.field.set_axles([a for group in self.parked.values() for a in group], self.fleet.wheelsets())
 
     def doors(self, platform: str, action: str) -> Result:
         """Open or close a platform's screen doors through the interlocking (the ``doors`` command, the ATO)."""

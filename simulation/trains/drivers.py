@@ -14,7 +14,7 @@ from dataclasses import dataclass
 from math import sqrt
 
 from liansuo.rules import RuleSet, load_rules
-from liansuo.stations.schema import EndKind, SignalKind
+from liansuo.stations.schema import Direction, EndKind, Signal, SignalKind
 from liansuo.stations.station import Station
 
 from .movement import Position, Track
@@ -34,33 +34,54 @@ class Ahead:
     what: str
 
 
+class Lookout:
+    """What drivers look out for at a station under a rule set, sorted out once: the signals at a node that a
+    movement heeds (a train movement train signals only; a shunting movement shunting signals and signals with a
+    shunting aspect), the aspects to stop at and the speed each other aspect allows."""
+
+    def __init__(self, station: Station, rules: RuleSet) -> None:
+        self.station = station
+        self.names = rules.aspects
+        self.closed = rules.aspects.closed
+        self.speeds_kmh = rules.driving.aspect_speed_kmh
+        self.buffer_margin_m = rules.driving.buffer_margin_m
+        self._heeded: dict[tuple[str, Direction, bool], list[Signal]] = {}
+
+    def heeded(self, node: str, direction: Direction, shunting: bool) -> list[Signal]:
+        key = (node, direction, shunting)
+        found = self._heeded.get(key)
+        if found is None:
+            names = self.names
+            found = self._heeded[key] = [
+                sig for sig in self.station.signals_at(node) if sig.direction is direction
+                and ((sig.kind is SignalKind.shunting) == shunting
+                     or (shunting and names.can_show(names.shunt, [lp.value for lp in sig.lamps])))]
+        return found
+
+
 def look_ahead(track: Track, pos: Position, station: Station, aspects: dict[str, str], horizon: float,
                margin: float, *, shunting: bool, boundary_stops: bool = False,
-               rules: RuleSet | None = None) -> list[Ahead]:
+               rules: RuleSet | None = None, lookout: Lookout | None = None) -> list[Ahead]:
     """Signals, buffer stops and (optionally) the boundary ahead along the rails as they lie now. A train movement
     is governed by train signals only; a shunting movement by shunting signals and signals with a shunting aspect,
-    and it stops before a shunting signal at stop."""
+    and it stops before a shunting signal at stop. ``lookout``: the station sorted out for the rules (made here if
+    not given)."""
     out: list[Ahead] = []
-    rules = rules or load_rules()
-    names, driving = rules.aspects, rules.driving
+    lookout = lookout or Lookout(station, rules or load_rules())
+    closed, speeds_kmh, ends = lookout.closed, lookout.speeds_kmh, station.ends
     direction = pos.moves[-1][1]
     for dist, node, _move in track.ahead(pos, horizon):
-        for sig in station.signals_at(node):
-            if sig.direction is not direction:
-                continue
-            shunt_aspect = names.can_show(names.shunt, [lp.value for lp in sig.lamps])
-            if (sig.kind is SignalKind.shunting) != shunting and not (shunting and shunt_aspect):
-                continue  # not this movement's signal
+        for sig in lookout.heeded(node, direction, shunting):
             aspect = aspects.get(sig.id, "")
-            if aspect in names.closed:
+            if aspect in closed:
                 out.append(Ahead(dist - margin, 0.0, f"signal {sig.id} at {aspect or 'dark'}"))
                 return out
-            limit = driving.aspect_speed_kmh.get(aspect)
+            limit = speeds_kmh.get(aspect)
             if limit is not None:
                 out.append(Ahead(dist, limit / 3.6, f"signal {sig.id} at {aspect}"))
-        end = station.ends.get(node)
+        end = ends.get(node)
         if end is not None and (end.kind is EndKind.buffer or boundary_stops):
-            out.append(Ahead(dist - driving.buffer_margin_m, 0.0, f"{end.kind.value} {node}"))
+            out.append(Ahead(dist - lookout.buffer_margin_m, 0.0, f"{end.kind.value} {node}"))
             return out
     return out
 

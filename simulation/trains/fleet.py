@@ -1,7 +1,8 @@
 """The built-in kinematic train engine: trains as consists of wheelsets moving over the topology.
 
 Each step every train picks a target speed from its driver, accelerates or brakes towards it, moves, and the field
-is told where every wheelset stands, so the track circuits (and through them the interlocking) see the trains.
+is told where every wheelset stands, so the track circuits (and through them the interlocking) see the trains: as
+the sections each train shunts, worked out again only when they can have changed (:mod:`.wheelsets`).
 """
 
 from __future__ import annotations
@@ -12,15 +13,16 @@ from dataclasses import dataclass, field
 from liansuo.circuits.field import Field
 from liansuo.circuits.railgeometry import Axle
 from liansuo.rules import RuleSet, load_rules
-from liansuo.stations.schema import Direction
+from liansuo.stations.schema import Direction, Marker
 from liansuo.stations.station import Station
 
 from .autoshunt import EmergencyStops
 from .consist import Consist
-from .drivers import look_ahead, stopping_speed, target_speed
+from .drivers import Lookout, look_ahead, stopping_speed, target_speed
 from .engine import KinematicEngine, MotionEngine
 from .movement import OUTSIDE, Notify, Position, Track
 from .odometry import Odometer
+from .wheelsets import TrainWheelsets, wheelsets_now
 
 MODES = ("manual", "signal", "auto")
 WHEEL_OHM = Axle._field_defaults["ohm"]  # a clean wheelset
@@ -65,6 +67,7 @@ class Train:
     slip_from: float = 0.0
     slip_until: float = 0.0
     extra: dict[str, object] = field(default_factory=dict)
+    wheelsets: TrainWheelsets | None = field(default=None, repr=False, compare=False)  # as the field last took them
 
     @property
     def direction(self) -> Direction:
@@ -100,6 +103,11 @@ class Fleet:
         self.station = station
         self.field = fld
         self.track = Track(station, fld)
+        self.lookout = Lookout(station, self.rules)  # what drivers look out for, sorted out once
+        self.tags: dict[str, list[Marker]] = {}  # balises and RFID tags by track, in the station's order
+        for mk in station.model.markers:
+            if mk.kind.value in ("balise", "rfid"):
+                self.tags.setdefault(mk.track, []).append(mk)
         self.aspects = aspects
         self.notify = notify
         self.trains: dict[str, Train] = {}
@@ -171,10 +179,8 @@ class Fleet:
                 break
             if node in self.station.joints:  # passed (ds - dist) / v seconds before the end of this step
                 tr.odometer.section_transition(before + dist, since_s=(ds - dist) / v)
-        for start, move in self.track.moves_ahead(tr.pos, ds):
-            for mk in self.station.model.markers:
-                if mk.track != move[0] or mk.kind.value not in ("balise", "rfid"):
-                    continue
+        for start, move in self.track.moves_ahead(tr.pos, ds) if self.tags else ():
+            for mk in self.tags.get(move[0], ()):
                 s = self.track.s_of_x(move, mk.at)
                 if s is not None and 0.0 <= start + s < ds:
                     tr.odometer.correct(before + start + s, mk.kind.value, since_s=(ds - start - s) / v)
@@ -208,7 +214,8 @@ class Fleet:
         horizon = tr.speed_ms ** 2 / (2 * c.brake_ms2) + 400.0
         margin = rules.shunt_margin_m if tr.mode == "auto" else rules.stop_margin_m
         ahead = look_ahead(self.track, tr.pos, self.station, self.aspects(), horizon, margin,
-                           shunting=tr.shunting, boundary_stops=tr.mode == "auto", rules=self.rules)
+                           shunting=tr.shunting, boundary_stops=tr.mode == "auto", rules=self.rules,
+                           lookout=self.lookout)
         v, why = target_speed(tr.aspect_limit_ms, vmax, ahead, c.brake_ms2, lead_m=tr.speed_ms * self.dt)
         if tr.mode == "auto" and self.auto_limit is not None:
             extra = self.auto_limit(tr)
@@ -227,9 +234,12 @@ class Fleet:
         return float(stop) if isinstance(stop, float | int) else None
 
     def _note_signals_passed(self, tr: Train, ds: float) -> None:
+        passing = self.track.ahead(tr.pos, ds)
+        if not passing:
+            return
         rules = self.rules.driving
         aspects = self.aspects()
-        for dist, node, _ in self.track.ahead(tr.pos, ds):
+        for dist, node, _ in passing:
             if dist > ds:
                 break
             for sig in self.station.signals_at(node):
@@ -288,18 +298,15 @@ class Fleet:
         return target, why
 
     # ---- what the track circuits and front ends see -----------------------------------------------------------
-    def shunts(self) -> dict[str, list[tuple[float, float]]]:
-        """The shunts of every train by section; a train that has not moved keeps its last ones."""
-        out: dict[str, list[tuple[float, float]]] = {}
+    def wheelsets(self) -> dict[str, TrainWheelsets]:
+        """Where every train's wheelsets stand, by train, as the field takes them (``Field.set_axles``): a train that
+        has not moved keeps its object, and the sections it shunts are worked out again only when they can have
+        changed."""
+        out: dict[str, TrainWheelsets] = {}
         geometry = self.field.geometry
         for tr in self.trains.values():
-            key = (len(tr.pos.moves), tr.pos.moves[-1], tr.pos.front_s)
-            cached = tr.extra.get("shunts")
-            if not (isinstance(cached, tuple) and cached[0] == key):
-                cached = (key, self.track.shunts(tr.pos, tr.consist.axle_offsets_m, geometry, WHEEL_OHM))
-                tr.extra["shunts"] = cached
-            for sec, lst in cached[1].items():
-                out.setdefault(sec, []).extend(lst)
+            w = wheelsets_now(self.track, geometry, tr.wheelsets, tr.pos, tr.consist.axle_offsets_m, WHEEL_OHM)
+            tr.wheelsets = out[tr.name] = w
         return out
 
     def sections_of(self, tr: Train) -> tuple[str, ...]:

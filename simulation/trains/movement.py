@@ -13,6 +13,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from liansuo.circuits.field import Field
+from liansuo.circuits.machines import SwitchMachine
 from liansuo.circuits.railgeometry import Axle, RailGeometry
 from liansuo.stations.schema import Direction, EndKind
 from liansuo.stations.station import Station
@@ -31,6 +32,28 @@ class Position:
     moves: list[Move]
     front_s: float  # metres of the front into the last move
     exits: list[str] = field(default_factory=list)  # boundary the front left through (for OUTSIDE moves)
+    rails_ahead: RailsAhead | None = field(default=None, repr=False, compare=False)  # ``Track``'s, for the way ahead
+
+
+class RailsAhead:
+    """The front's move and the moves after it along the rails as they lay, worked out as far as asked, with each
+    move's length and far node; ``Track`` keeps it on the train's position while the front stays on its move and
+    every turnout it passes facing (``consulted``) has its switch rails where they were."""
+
+    __slots__ = ("consulted", "ended", "lengths", "moves", "nodes", "track")
+
+    def __init__(self, track: Track, front: Move, length: float, node: str | None) -> None:
+        self.track = track  # whose field's turnouts it follows
+        self.moves = [front]
+        self.lengths = [length]
+        self.nodes = [node]  # None for the open line beyond a boundary
+        self.consulted: list[tuple[SwitchMachine, str | None]] = []  # (machine, where its rails lay)
+        self.ended = front[0] == OUTSIDE  # no move after the last one (a buffer stop, the open line, no position)
+
+    def holds(self, track: Track, front: Move) -> bool:
+        if self.track is not track or self.moves[0] != front:
+            return False
+        return not self.consulted or all(machine.rails == rails for machine, rails in self.consulted)
 
 
 class Track:
@@ -41,7 +64,7 @@ class Track:
         self.topo = station.topology
         self.field = fld
         # per track: (position at its low end, at its high end, length), for the hot path of wheelset positions
-        self._geo = {t: (*station.track_span(t), station.track_length(t)) for t in station.tracks}
+        self.geo = {t: (*station.track_span(t), station.track_length(t)) for t in station.tracks}
 
     def length(self, move: Move) -> float:
         return OUTSIDE_LENGTH if move[0] == OUTSIDE else self.station.track_length(move[0])
@@ -100,7 +123,10 @@ class Track:
             return None
         return (nxt[0], move[1])  # OUTSIDE when the track behind runs out of the model onto the open line
 
-    def _next(self, move: Move, *, follow_rails: bool) -> Move | None:
+    def _next(self, move: Move, *, follow_rails: bool,
+              consulted: list[tuple[SwitchMachine, str | None]] | None = None) -> Move | None:
+        """The move after ``move``: through a turnout faced, the leg its rails lie on (``follow_rails``: none if
+        they lie on neither, else the first leg); each machine whose rails it looked at goes into ``consulted``."""
         options = self.topo.next_moves(move)
         if not options:
             far = self.topo.far_node(move)
@@ -111,8 +137,10 @@ class Track:
         if len(options) == 1:
             return options[0][0]
         for nxt, data in options:
-            rails = self.field.machines[str(data["turnout"])].rails
-            if rails == data["position"]:
+            machine = self.field.machines[str(data["turnout"])]
+            if consulted is not None:
+                consulted.append((machine, machine.rails))
+            if machine.rails == data["position"]:
                 return nxt
         return options[0][0] if not follow_rails else None
 
@@ -174,12 +202,12 @@ class Track:
         idx = len(moves) - 1
         back_of_move = pos.front_s  # distance from the front to the start of move idx
         track, down = moves[idx][0], moves[idx][1] is Direction.down
-        geo = self._geo.get(track)
+        geo = self.geo.get(track)
         for off in offsets:
             while off > back_of_move and idx > 0:
                 idx -= 1
                 track, down = moves[idx][0], moves[idx][1] is Direction.down
-                geo = self._geo.get(track)
+                geo = self.geo.get(track)
                 back_of_move += OUTSIDE_LENGTH if geo is None else geo[2]
             if geo is None or off > back_of_move:
                 continue
@@ -190,8 +218,9 @@ class Track:
 
     def shunts(self, pos: Position, offsets: tuple[float, ...], geometry: RailGeometry,
                ohm: float) -> dict[str, list[tuple[float, float]]]:
-        """The shunts this train's wheelsets make, by section: ``axles`` and ``RailGeometry.shunts_of`` in one pass,
-        the hot path of a yard full of trains."""
+        """The shunts this train's wheelsets make, by section: ``axles`` and ``RailGeometry.shunts_of`` in one pass.
+        Worked out only when the field asks (``wheelsets.TrainWheelsets``); ``wheelsets.sections_shunted`` finds
+        the sections the same way without placing each wheelset."""
         out: dict[str, list[tuple[float, float]]] = {}
         moves = pos.moves
         idx = len(moves) - 1
@@ -203,7 +232,7 @@ class Track:
         def segment(i: int) -> tuple[float, float, float, bool, list[tuple[float, float]], float, float,
                                      list[tuple[float, float]]] | None:
             track, d = moves[i]
-            geo = self._geo.get(track)
+            geo = self.geo.get(track)
             if geo is None:
                 return None
             sec = sections[track].section
@@ -248,16 +277,45 @@ class Track:
         """The front's move and those after it along the rails as they lie now, each with the distance from the
         front to the move's start (negative for the front's own move)."""
         out: list[tuple[float, Move]] = []
-        move = pos.moves[-1]
+        way = self._rails_ahead(pos)
+        k = 0
+        move = way.moves[0]
         start = -pos.front_s
         while move[0] != OUTSIDE and start <= horizon:
             out.append((start, move))
-            start += self.length(move)
-            nxt = self._next(move, follow_rails=True)
+            start += way.lengths[k]
+            nxt = self._move_after(way, k)
             if nxt is None:
                 break
+            k += 1
             move = nxt
         return out
+
+    def _rails_ahead(self, pos: Position) -> RailsAhead:
+        """The way ahead of the front as the rails lie now: the one kept on ``pos`` while it holds."""
+        front = pos.moves[-1]
+        way = pos.rails_ahead
+        if way is None or not way.holds(self, front):
+            way = pos.rails_ahead = RailsAhead(self, front, self.length(front),
+                                               None if front[0] == OUTSIDE else self.topo.far_node(front))
+        return way
+
+    def _move_after(self, way: RailsAhead, k: int) -> Move | None:
+        """The move after ``way.moves[k]`` along the rails (worked out now if it has not been yet), or None."""
+        if k + 1 < len(way.moves):
+            return way.moves[k + 1]
+        if way.ended:
+            return None
+        nxt = self._next(way.moves[k], follow_rails=True, consulted=way.consulted)
+        if nxt is None:
+            way.ended = True
+            return None
+        outside = nxt[0] == OUTSIDE
+        way.moves.append(nxt)
+        way.lengths.append(self.length(nxt))
+        way.nodes.append(None if outside else self.topo.far_node(nxt))
+        way.ended = outside
+        return nxt
 
     def s_of_x(self, move: Move, x: float) -> float | None:
         """How far into ``move`` the position ``x`` lies, if it lies on the move's track."""
@@ -271,14 +329,21 @@ class Track:
         """Nodes ahead of the front within ``horizon`` metres along the way the rails lie now: (distance, node,
         the move arriving at it)."""
         out: list[tuple[float, str, Move]] = []
-        move = pos.moves[-1]
-        dist = self.length(move) - pos.front_s
+        geo = self.geo.get(pos.moves[-1][0])
+        if geo is not None and geo[2] - pos.front_s > horizon:
+            return out  # no node before the horizon (the common case of a step's run)
+        way = self._rails_ahead(pos)
+        k = 0
+        move = way.moves[0]
+        dist = way.lengths[0] - pos.front_s
         while dist <= horizon and move[0] != OUTSIDE:
-            node = self.topo.far_node(move)
+            node = way.nodes[k]
+            assert node is not None
             out.append((dist, node, move))
-            nxt = self._next(move, follow_rails=True)
+            nxt = self._move_after(way, k)
             if nxt is None or nxt[0] == OUTSIDE:
                 break
+            k += 1
             move = nxt
-            dist += self.length(move)
+            dist += way.lengths[k]
         return out

@@ -71,7 +71,8 @@ class Odometer:
         self._est = 0.0  # speed estimate now (the window speed lags by half a window; given out when compensating)
         self._hold = 0.0  # plausible acceleration before the episode, used without an accelerometer
         self._state: State = "normal"
-        self._win: deque[tuple[float, int]] = deque()  # (dt, pulses) over the window
+        self._win_dt: deque[float] = deque()  # the sampling intervals over the window
+        self._win_n: deque[int] = deque()  # and the pulses in each
         self._hist: deque[_Sample] = deque()
         self._carry = 0.0  # fraction of a pulse (update())
         self._episode_t = 0.0
@@ -118,43 +119,55 @@ class Odometer:
         ``gradient_permille`` rising in the direction of travel: from the line data, or the steepest as a bound)."""
         if dt <= 0 or count < 0:
             raise ValueError("need dt > 0 and count >= 0")
-        self.t += dt
-        self._win.append((dt, count))
-        while len(self._win) > 1 and sum(d for d, _ in self._win) - self._win[0][0] >= self.window_s - 1e-9:
-            self._win.popleft()
-        span = sum(d for d, _ in self._win)
-        wheel = math.pi * self.wheel_diameter_m * sum(n for _, n in self._win) / (self.pulses_per_rev * span)
-        ref = next((h for h in reversed(self._hist) if h.t <= self.t - self.window_s + 1e-9), None)
-        a_wheel = (wheel - ref.wheel_ms) / (self.t - ref.t) if ref is not None else 0.0
+        t = self.t = self.t + dt
+        window = self.window_s
+        win_dt, win_n = self._win_dt, self._win_n
+        win_dt.append(dt)
+        win_n.append(count)
+        while len(win_dt) > 1 and sum(win_dt) - win_dt[0] >= window - 1e-9:
+            win_dt.popleft()
+            win_n.popleft()
+        span = sum(win_dt)
+        wheel = math.pi * self.wheel_diameter_m * sum(win_n) / (self.pulses_per_rev * span)
+        hist = self._hist
+        ref = None
+        since = t - window + 1e-9
+        for h in reversed(hist):  # the newest sample a window ago
+            if h.t <= since:
+                ref = h
+                break
+        a_wheel = (wheel - ref.wheel_ms) / (t - ref.t) if ref is not None else 0.0
         a_comp = self._hold if accel_ms2 is None else accel_ms2 - G * gradient_permille / 1000.0
-        step = count * self.metres_per_pulse
-        if self._state == "normal":
+        mpp = self.metres_per_pulse
+        step = count * mpp
+        state = self._state
+        if state == "normal":
             kind: State | None = "slip" if a_wheel > self.a_max else "slide" if a_wheel < self.a_min else None
             if kind is None or ref is None:
-                self._est = wheel + self._hold * self.window_s / 2
+                self._est = wheel + self._hold * window / 2
                 self._hold = min(max(a_wheel, self.a_min), self.a_max)
                 self._position += step
             else:
-                self._begin(kind, self._hist[0], accel_ms2, gradient_permille, step)
+                self._begin(kind, hist[0], accel_ms2, gradient_permille, step)
         else:
             before = self._est
-            self._est = max(0.0, self._est + a_comp * dt)
-            if self._state == "slip":  # a spinning wheel runs faster than the locomotive: an upper bound
-                self._est = min(self._est, (count + 1) * self.metres_per_pulse / dt)
-            else:  # a locked wheel runs slower: a lower bound
-                self._est = max(self._est, (count - 1) * self.metres_per_pulse / dt)
-            self._position += (before + self._est) / 2 * dt if self.compensate else step
+            est = max(0.0, before + a_comp * dt)
+            # a spinning wheel runs faster than the locomotive (an upper bound), a locked one slower (a lower bound)
+            est = min(est, (count + 1) * mpp / dt) if state == "slip" else max(est, (count - 1) * mpp / dt)
+            self._est = est
+            self._position += (before + est) / 2 * dt if self.compensate else step
             self._episode_t += dt
-            lagged = self._est - a_comp * self.window_s / 2  # what the window speed should read
+            lagged = est - a_comp * window / 2  # what the window speed should read
             tol = self.recover_tol_ms + self.drift_ms2 * self._episode_t
-            agree = abs(wheel - lagged) <= tol or (wheel == 0.0 and self._est == 0.0)
+            agree = abs(wheel - lagged) <= tol or (wheel == 0.0 and est == 0.0)
             self._agree_t = self._agree_t + dt if agree else 0.0
             if self._agree_t >= self.recover_s or self._episode_t >= self.max_compensation_s:
                 self._state = "normal"
         self._speed = self._est if self.compensate and self._state != "normal" else wheel
-        self._hist.append(_Sample(self.t, wheel, self._est, self._position, a_wheel))
-        while len(self._hist) > 1 and self._hist[1].t <= self.t - 2 * self.window_s + 1e-9:
-            self._hist.popleft()
+        hist.append(_Sample(t, wheel, self._est, self._position, a_wheel))
+        forget = t - 2 * window + 1e-9
+        while len(hist) > 1 and hist[1].t <= forget:
+            hist.popleft()
 
     def _begin(self, kind: State, ref: _Sample, accel_ms2: float | None, gradient_permille: float,
                step: float) -> None:
