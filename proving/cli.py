@@ -18,6 +18,7 @@ from liansuo.simulation.trains.sumo import SumoEngineError
 from liansuo.simulation.trains.sumo_export import SumoExportError, SumoUnavailable
 from liansuo.stations.arguments import unwritable
 from liansuo.stations.exitcodes import Exit, bad_input, refuse
+from liansuo.stations.fit import fit_all
 from liansuo.stations.jsonreport import print_report
 from liansuo.stations.source import StationError
 from liansuo.stations.station import Station
@@ -80,16 +81,17 @@ def cmd_test(args: argparse.Namespace) -> int:
 
 
 def _print_outcomes(outcomes: list[Outcome], verbose: bool) -> None:
+    lines: list[str] = []
     for o in outcomes:
         if o.passed:
-            print(f"PASS {o.script}: {o.name}")
-            for h in o.hazards:
-                print(f"    HAZARD {h}")
+            lines.append(f"PASS {o.script}: {o.name}")
+            lines += [f"    HAZARD {h}" for h in o.hazards]
         else:
-            print(f"FAIL {o.script}:{o.line}: {o.name}\n    {o.failure}")
+            lines += [f"FAIL {o.script}:{o.line}: {o.name}", f"    {o.failure}"]
             if verbose:
-                for entry in o.log:
-                    print(f"      {entry}")
+                lines += [f"      {entry}" for entry in o.log]
+    if lines:
+        print(fit_all(lines))
 
 
 def cmd_run(args: argparse.Namespace) -> int:

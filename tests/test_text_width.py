@@ -41,7 +41,9 @@ def test_check_fits_100_columns(station: str) -> None:
 
 @pytest.mark.parametrize("args", [("stations",), ("zpw", "gaotie"), ("verify", "examples/stations/minimal.yaml"),
                                   ("soak", "jiaopei", "--steps", "150"),
-                                  ("run", "examples/scenarios/jiaopei-receive-depart.yaml")])
+                                  ("run", "examples/scenarios/jiaopei-receive-depart.yaml"),
+                                  ("test", "examples/scripts/jiaopei-interlocking-test.yaml"),
+                                  ("test", "-v", "examples/scripts/dead-zone-hazard.yaml")])
 def test_text_commands_fit_100_columns(args: tuple[str, ...]) -> None:
     out = liansuo(*args)
     assert out.strip()
