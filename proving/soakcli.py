@@ -18,7 +18,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 from liansuo.simulation.sim import Simulation
-from liansuo.stations.arguments import positive_int
+from liansuo.stations.arguments import count, positive_int
 from liansuo.stations.exitcodes import Exit, bad_input, refuse
 from liansuo.stations.fit import fit_all
 from liansuo.stations.jsonreport import print_report
@@ -26,7 +26,7 @@ from liansuo.stations.jsonreport import print_report
 from .oracle import Violation, Watch
 from .progress import progress
 from .soak import SoakRun, soak
-from .spread import SpreadError, count, fan_out
+from .spread import SpreadError, fan_out
 
 Add = Callable[..., argparse.ArgumentParser]
 MAX_REPRODUCERS = 5

@@ -26,19 +26,6 @@ class SpreadError(Exception):
     """The cluster could not be reached or started: the message says what to do."""
 
 
-def count(text: str) -> int:
-    """``--workers`` / ``--runs``: a whole number, 0 or more (argparse type)."""
-    import argparse
-
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"{value} is negative; give 0 (run here) or more")
-    return value
-
-
 @contextmanager
 def client(workers: int, scheduler: str | None) -> Iterator[Any]:
     """A Dask client: on the cluster at ``scheduler``, or on ``workers`` local worker processes of one thread each

@@ -9,12 +9,21 @@ from pathlib import Path
 
 def positive_int(text: str) -> int:
     """An argparse type: a whole number of at least 1 (``--turnouts``, ``--steps``)."""
+    return _whole(text, 1, "is not a positive number")
+
+
+def count(text: str) -> int:
+    """An argparse type: a whole number, 0 or more (``--workers``, ``--runs``: 0 runs here, in no cluster)."""
+    return _whole(text, 0, "is negative; give 0 (run here) or more")
+
+
+def _whole(text: str, least: int, below: str) -> int:
     try:
         value = int(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"{value} is not a positive number")
+    if value < least:
+        raise argparse.ArgumentTypeError(f"{value} {below}")
     return value
 
 

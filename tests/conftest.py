@@ -29,6 +29,23 @@ class Driver:
         return self.sim.aspect(signal)
 
 
+# a script of two tests, one passing and one failing (its aspect is wrong): for the reports of `liansuo test`
+TWO_TESTS_SCRIPT = """\
+station: jiaopei
+tests:
+  - name: receiving route opens
+    steps:
+      - route X XI
+      - run 2s
+      - expect signal X U
+  - name: wrong aspect
+    steps:
+      - route X XI
+      - run 2s
+      - expect signal X L
+"""
+
+
 def edit(text: str, *pairs: tuple[str, str]) -> str:
     """A station or script text with each ``old`` (which must occur exactly once) replaced by ``new``."""
     for old, new in pairs:

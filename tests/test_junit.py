@@ -9,26 +9,13 @@ from xml.etree import ElementTree
 
 import pytest
 import xmlschema
+from conftest import TWO_TESTS_SCRIPT
 
 from liansuo.cli.main import main
 
 XSD = Path(__file__).parent / "data" / "junit-10.xsd"
 EXAMPLE = Path(__file__).parent.parent / "examples" / "scripts"
 
-SCRIPT = """\
-station: jiaopei
-tests:
-  - name: receiving route opens
-    steps:
-      - route X XI
-      - run 2s
-      - expect signal X U
-  - name: wrong aspect
-    steps:
-      - route X XI
-      - run 2s
-      - expect signal X L
-"""
 
 
 @pytest.fixture(scope="module")
@@ -66,7 +53,7 @@ def test_a_passing_run_is_valid_with_times_timestamp_and_hostname(
 def test_failures_and_errors_are_counted_apart_and_say_why(
         tmp_path: Path, schema: xmlschema.XMLSchema, capsys: pytest.CaptureFixture[str]) -> None:
     good = tmp_path / "routes.yaml"
-    good.write_text(SCRIPT, encoding="utf-8")
+    good.write_text(TWO_TESTS_SCRIPT, encoding="utf-8")
     malformed = tmp_path / "malformed.yaml"
     malformed.write_text("station: jiaopei\ntests:\n  - name: x\n    steps:\n      - rout X XI\n", encoding="utf-8")
     no_station = tmp_path / "no-station.yaml"

@@ -9,6 +9,7 @@ from pathlib import Path
 
 import pytest
 import xmlschema
+from conftest import TWO_TESTS_SCRIPT
 
 pytest_plugins = ["pytester"]
 
@@ -16,27 +17,13 @@ ROOT = Path(__file__).parent.parent
 # the inner runs need neither the cache nor the Textual snapshot plugin (whose session hook expects its own run)
 QUIET = ("-p", "no:cacheprovider", "-p", "no:textual-snapshot")
 
-SCRIPT = """\
-station: jiaopei
-tests:
-  - name: receiving route opens
-    steps:
-      - route X XI
-      - run 2s
-      - expect signal X U
-  - name: wrong aspect
-    steps:
-      - route X XI
-      - run 2s
-      - expect signal X L
-"""
 
 
 def test_scripts_are_collected_and_failures_show_step_expectation_and_state(pytester: pytest.Pytester) -> None:
-    pytester.makefile(".yaml", test_routes=SCRIPT)
+    pytester.makefile(".yaml", test_routes=TWO_TESTS_SCRIPT)
     station = (ROOT / "stations/library/jiaopei.yaml").read_text("utf-8")
     (pytester.path / "test_jiaopei.yaml").write_text(station, encoding="utf-8")  # a station file: not a script
-    (pytester.path / "other.yaml").write_text(SCRIPT, encoding="utf-8")  # no pattern: not collected
+    (pytester.path / "other.yaml").write_text(TWO_TESTS_SCRIPT, encoding="utf-8")  # no pattern: not collected
     result = pytester.runpytest(*QUIET, "--junitxml=report.xml")
     result.assert_outcomes(passed=1, failed=1)
     out = result.stdout.str()
@@ -48,15 +35,15 @@ def test_scripts_are_collected_and_failures_show_step_expectation_and_state(pyte
 
 
 def test_keyword_selection_and_explicit_paths(pytester: pytest.Pytester) -> None:
-    pytester.makefile(".yaml", routes=SCRIPT)  # matches no pattern, but named on the command line
+    pytester.makefile(".yaml", routes=TWO_TESTS_SCRIPT)  # matches no pattern, but named on the command line
     result = pytester.runpytest(*QUIET, "routes.yaml", "-k", "opens")
     result.assert_outcomes(passed=1, deselected=1)
 
 
 def test_patterns_are_configurable(pytester: pytest.Pytester) -> None:
     pytester.makeini("[pytest]\nliansuo_scripts = *.check.yaml\n")
-    pytester.makefile(".check.yaml", routes=SCRIPT)
-    pytester.makefile(".yaml", test_other=SCRIPT)
+    pytester.makefile(".check.yaml", routes=TWO_TESTS_SCRIPT)
+    pytester.makefile(".yaml", test_other=TWO_TESTS_SCRIPT)
     result = pytester.runpytest(*QUIET)
     result.assert_outcomes(passed=1, failed=1)
 

@@ -6,10 +6,11 @@ from __future__ import annotations
 import argparse
 from collections.abc import Callable
 
+from liansuo.stations.arguments import count
 from liansuo.stations.exitcodes import Exit, bad_input, refuse
 from liansuo.stations.jsonreport import print_report
 
-from ..spread import SpreadError, count
+from ..spread import SpreadError
 
 Add = Callable[..., argparse.ArgumentParser]
 
