@@ -7,9 +7,12 @@ maintainer finds it.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 from liansuo.stations.station import Station
+
+from .physical import ballast_problem
 
 TargetKind = str  # "section", "joint-or-turnout", "signal", "turnout", "platform"
 
@@ -99,11 +102,17 @@ def parse_fault(station: Station, kind_name: str, target: str, args: list[str]) 
         default = kind.params[key]
         if isinstance(default, float):
             try:
-                params[key] = float(value)
+                number = float(value)
             except ValueError:
                 return f"fault {kind_name}: {key} must be a number, not '{value}'"
-            if params[key] < 0 and key != "at":  # type: ignore[operator]
+            if not math.isfinite(number):
+                return f"fault {kind_name}: {key} must be a finite number, not '{value}'"
+            if key == "ohm_km" and (why := ballast_problem(number, infinite_ok=False)):
+                return (f"fault {kind_name}: ohm_km {why}, not '{value}' (wet or dirty ballast is a few tenths of "
+                        "an ohm*km, e.g. ohm_km=0.3)")
+            if number < 0 and key != "at":
                 return f"fault {kind_name}: {key} cannot be negative"
+            params[key] = number
         else:
             if key in kind.choices and value not in kind.choices[key]:
                 return f"fault {kind_name}: {key} must be one of {', '.join(kind.choices[key])}"

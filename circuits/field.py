@@ -10,6 +10,7 @@ says what changed since it was last called, so the one reading them copies only 
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 
@@ -54,8 +55,9 @@ class Field:
         rules = rules or load_rules()
         self.flasher_lamp = rules.aspects.flasher_lamp
         self.geometry = geometry_of(station)
+        longest_25hz = rules.design.phase25hz_max_length_m
         self.circuits: dict[str, SectionCircuit] = {
-            s: build_circuit(station, s, self.geometry.section_length[s]) for s in station.sections}
+            s: build_circuit(station, s, self.geometry.section_length[s], longest_25hz) for s in station.sections}
         self.machines = {t.id: SwitchMachine(t.id, t.machine.value, equipment=rules.equipment)
                          for t in station.model.turnouts}
         self.lamps = {s.id: SignalLamps([lamp.value for lamp in s.lamps]) for s in station.model.signals}
@@ -94,14 +96,23 @@ class Field:
     def set_axles(self, axles: Iterable[Axle], groups: Mapping[str, WheelsetGroup] | None = None) -> None:
         """Where every wheelset stands now: loose ``axles``, and ``groups`` of wheelsets moving together (trains, by
         name). Sections whose shunts changed are re-evaluated, except that a circuit down by a standard shunt is
-        not re-evaluated while its groups' wheelsets only move on it (it stays down by design)."""
-        self.axles = list(axles)
+        not re-evaluated while its groups' wheelsets only move on it (it stays down by design). A loose wheelset
+        whose position is not a finite number raises ``ValueError`` and changes nothing."""
+        axles = list(axles)
+        for a in axles:
+            if not math.isfinite(a.x):
+                raise ValueError(f"a wheelset on track {a.track} must stand at a finite number of metres, got {a.x!r}")
+        self.axles = axles
         loose = self.geometry.shunts_of(self.axles)
         groups = dict(groups or {})
         touched = changed_sections(self.on_track, loose, groups, self._settled)
         self.on_track.loose, self.on_track.groups = loose, groups
         for sec in touched:
             self._reevaluate(sec, if_changed=True)
+
+    def held_down(self) -> dict[str, str]:
+        """Sections whose track relay is held down for good (past their model's range), with the reason."""
+        return {s: c.held_down for s, c in self.circuits.items() if c.held_down}
 
     def shunts_on(self, section: str) -> list[Shunt]:
         """Every shunt on ``section`` now: (distance from its low end, ohm)."""

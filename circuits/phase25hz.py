@@ -19,6 +19,10 @@ torque and can never pick it up.
 
 Time does not appear: the circuit is quasi-static at 25 Hz. Hysteresis needs the previous relay state, passed in.
 Figures and their sources are in docs/track-circuits-25hz.md.
+
+Range: the model vouches for sections up to ``MAX_LENGTH_M``. Longer ones are refused unless asked for
+(``beyond_range=True``): in dry ballast a standard shunt no longer drops their relay. Ballast resistances <= 0 or
+NaN and positions that are not finite numbers raise ``ValueError`` (:mod:`.physical`).
 """
 
 from __future__ import annotations
@@ -29,10 +33,17 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, replace
 from functools import lru_cache
 
+from .physical import check_ballast, check_position, check_shunts
+
 # one ABCD (transmission) matrix: (A, B, C, D) with V1 = A V2 + B I2, I1 = C V2 + D I2
 _Abcd = tuple[complex, complex, complex, complex]
 _IDENTITY: _Abcd = (1 + 0j, 0j, 0j, 1 + 0j)
 _MIN_SHUNT_OHM = 1e-6
+# The longest section the model vouches for (the design rule's 1500 m, rules/china/design.yaml): with the tap a
+# maintainer sets, a 0.06 ohm shunt anywhere leaves at most 7.4 V on the track coil even in dry (infinite) ballast
+# (6.9 V at 1500 m, 7.4 V at about 1650 m). Past it dry ballast holds the relay up under a train: 8.8 V at 2000 m,
+# 11.3 V at 2500 m, above the 8.6 V drop level (docs/track-circuits-25hz.md).
+MAX_LENGTH_M = 1500.0
 
 
 @dataclass(frozen=True)
@@ -72,6 +83,9 @@ class Phase25HzParams:
     standard_shunt_ohm: float = 0.06
     insulation_short_ohm: float = 0.01  # a failed switch-machine / joint insulation bridging the rails
 
+    def __post_init__(self) -> None:
+        check_ballast("ballast_ohm_km", self.ballast_ohm_km)
+
     @property
     def feed_transformer_ratio(self) -> float:
         """Turns ratio of the feed track transformer (primary : secondary) for the chosen tap."""
@@ -99,6 +113,14 @@ class Phase25HzFaults:
     joint_failure: bool = False  # the insulated joint at the relay end failed: the neighbour's feed leaks in
     neighbour_phase_deg: float = 180.0  # neighbour feed phase vs ours: 180 with rail polarity alternating
     joint_leak_ohm: float = 0.1  # resistance of the leak path through the failed joint (rail side)
+
+    def __post_init__(self) -> None:
+        if self.ballast_ohm_km is not None:
+            check_ballast("ballast_ohm_km", self.ballast_ohm_km)
+        if self.broken_rail_at_m is not None:
+            check_position("broken_rail_at_m", self.broken_rail_at_m)
+        if self.insulation_short_at_m is not None:
+            check_position("insulation_short_at_m", self.insulation_short_at_m)
 
 
 @dataclass(frozen=True)
@@ -159,11 +181,20 @@ def _shunt(resistance_ohm: float) -> _Abcd:
 
 
 class Phase25HzCircuit:
-    """One 25 Hz phase-sensitive section of ``length_m``; ``params`` None = adjusted as a maintainer would."""
+    """One 25 Hz phase-sensitive section of ``length_m``; ``params`` None = adjusted as a maintainer would.
 
-    def __init__(self, length_m: float, params: Phase25HzParams | None = None) -> None:
-        if length_m <= 0.0:
-            raise ValueError(f"section length must be positive, got {length_m} m")
+    A section longer than ``MAX_LENGTH_M`` is refused (``ValueError``) unless ``beyond_range`` is true, as for a
+    study of the model's limits: there a standard shunt does not drop the relay in dry ballast.
+    """
+
+    def __init__(self, length_m: float, params: Phase25HzParams | None = None, *, beyond_range: bool = False
+                 ) -> None:
+        if not (math.isfinite(length_m) and length_m > 0.0):
+            raise ValueError(f"length_m must be a positive number of metres, got {length_m!r}")
+        if length_m > MAX_LENGTH_M and not beyond_range:
+            raise ValueError(f"length_m {length_m:g} m is past the 25 Hz model's range ({MAX_LENGTH_M:g} m): in dry "
+                             "ballast a standard shunt would not drop the relay; split the section, or pass "
+                             "beyond_range=True to study the model there")
         self.length_m = float(length_m)
         self.params = params if params is not None else adjusted_params(length_m)
 
@@ -218,9 +249,11 @@ class Phase25HzCircuit:
 
     def evaluate(self, shunts: Sequence[tuple[float, float]] = (), faults: Phase25HzFaults | None = None
                  ) -> TrackCircuitState:
-        """Relay-end state for wheelset shunts ``(distance_from_feed_end_m, resistance_ohm)`` and faults."""
+        """Relay-end state for wheelset shunts ``(distance_from_feed_end_m, resistance_ohm)`` and faults. A shunt
+        position that is not a finite number raises ``ValueError``: such a wheelset lies nowhere."""
         if not shunts and (faults is None or faults == _HEALTHY):
             return _adjustment(self.length_m, self.params)  # the same for every circuit of this length and tap
+        check_shunts(shunts)
         return self._evaluate(shunts, faults)
 
     def _evaluate(self, shunts: Sequence[tuple[float, float]], faults: Phase25HzFaults | None) -> TrackCircuitState:
@@ -299,7 +332,7 @@ _HEALTHY = Phase25HzFaults()
 def _adjustment(length_m: float, params: Phase25HzParams) -> TrackCircuitState:
     """The adjustment state (no train, no fault) of a circuit: pure in its length and parameters, so worked out once
     for every simulation of a station (verify builds hundreds)."""
-    return Phase25HzCircuit(length_m, params)._evaluate((), None)
+    return Phase25HzCircuit(length_m, params, beyond_range=True)._evaluate((), None)
 
 
 TAP_STEP_V = 0.05  # feed transformer tap resolution of the model (secondary volts at nominal supply)
@@ -312,7 +345,7 @@ def adjusted_params(length_m: float, base: Phase25HzParams | None = None, target
     track coil at the base's ballast (the design minimum by default). 20 V keeps >= 18 V with the supply 10 % low.
     """
     p = base or Phase25HzParams()
-    unit = Phase25HzCircuit(length_m, replace(p, feed_tap_V=1.0, supply_V=p.nominal_supply_V))
+    unit = Phase25HzCircuit(length_m, replace(p, feed_tap_V=1.0, supply_V=p.nominal_supply_V), beyond_range=True)
     per_volt = unit.adjustment().voltage_V  # the circuit is linear in the feed voltage
     tap = math.ceil(target_V / per_volt / TAP_STEP_V - 1e-9) * TAP_STEP_V
     return replace(p, feed_tap_V=round(tap, 4))

@@ -3,11 +3,14 @@
 A wheelset connects the two rails where it stands. It shunts a track circuit only if both rails under it belong to
 the same section; between the staggered joints of the two rails (a dead zone, 死区段) it joins one rail of one
 section to the other rail of the next, and shunts nothing. A vehicle whose every wheelset stands in dead zones is
-invisible to the interlocking.
+invisible to the interlocking. A wheelset whose position is not a finite number (NaN, infinite) stands somewhere
+unknown on its track: fail-safe, it shunts its track's section at an unknown place (distance NaN), and the section's
+track circuit shows it occupied (:mod:`.trackcircuits`).
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import NamedTuple
 from weakref import WeakKeyDictionary
@@ -60,6 +63,8 @@ class RailGeometry:
             lo, hi = span[a.track]
             x = a.x
             if not lo - 1e-6 <= x <= hi + 1e-6:
+                if not math.isfinite(x):  # somewhere unknown on its track: occupied, never clear
+                    out.setdefault(tracks[a.track].section, []).append((math.nan, a.ohm))
                 continue
             zones = dead[a.track]
             if zones and any(z0 <= x < z1 for z0, z1 in zones):
@@ -73,7 +78,10 @@ class RailGeometry:
         return any(lo <= x < hi for lo, hi in self.track_dead[track])
 
     def shunt(self, axle: Axle) -> Shunt | None:
-        """The shunt this wheelset makes, or None in a dead zone (or off its track)."""
+        """The shunt this wheelset makes, or None in a dead zone (or off its track); at distance NaN if its position
+        is not a finite number (it shunts its section somewhere unknown)."""
+        if not math.isfinite(axle.x):
+            return Shunt(self.station.tracks[axle.track].section, math.nan, axle.ohm)
         lo, hi = self.track_span[axle.track]
         if not lo - 1e-6 <= axle.x <= hi + 1e-6 or self.in_dead_zone(axle.track, axle.x):
             return None

@@ -8,10 +8,16 @@ resistance), low ballast, failed insulation (at an insulated joint or a switch m
 compensation capacitors. A section of ``type: axle_counter`` has an axle counter (:mod:`.axlecounter`) instead: it
 counts wheelsets, so those faults do not touch it; its own fault is a miscount, and its count is reset by the
 operator (计轴复零).
+
+Fail-safe where the model cannot answer: a wheelset at an unknown place (a position that was not a finite number,
+:mod:`.railgeometry`) drops the relay, and a 25 Hz section longer than the model's range (``max_25hz_m``, at most
+:data:`.phase25hz.MAX_LENGTH_M`) is held down for good with the reason in ``held_down``: in dry ballast a standard
+shunt would not drop its relay, so the model could not show a train there.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
@@ -19,7 +25,7 @@ from liansuo.stations.schema import CircuitType
 from liansuo.stations.station import Station
 
 from .axlecounter import AxleCounter
-from .phase25hz import Phase25HzCircuit, Phase25HzFaults, adjusted_params
+from .phase25hz import MAX_LENGTH_M, Phase25HzCircuit, Phase25HzFaults, adjusted_params
 from .shunts import Listed, Shunt, Shunts
 
 
@@ -48,6 +54,7 @@ class SectionCircuit:
         self.model = model
         self.faults = SectionFaults()
         self.k_switch = False  # the teaching panel's switch K shorting the track
+        self.held_down = ""  # why the relay is held down for good (a section past its model's range), or ''
         self.up = False  # fail-safe until first evaluated
         self._voltage = 0.0  # V for 25 Hz, mV for ZPW-2000A
         self._cab_current_mA: float | None = None
@@ -114,12 +121,15 @@ class SectionCircuit:
         listed = shunts.listed()
         self._inside = len(listed)
         self._evaluate(listed)
-        if self.k_switch:
+        if self.k_switch or self.held_down:
             self.up = False
         return self.up
 
     def _evaluate(self, shunts: Sequence[tuple[float, float]]) -> None:
         f = self.faults
+        if not all(math.isfinite(d) for d, _ in shunts):  # a wheelset somewhere unknown: occupied, never clear
+            self._voltage, self._cab_current_mA, self.up = 0.0, None, False
+            return
         if f.poor_shunt_ohm is not None:
             shunts = [(d, max(r, f.poor_shunt_ohm)) for d, r in shunts]
         if self.kind is CircuitType.phase25hz:
@@ -148,13 +158,22 @@ def _clip(at: float | None, length: float) -> float | None:
     return length / 2 if at < 0 else min(at, length)
 
 
-def build_circuit(station: Station, section: str, length_m: float) -> SectionCircuit:
+def build_circuit(station: Station, section: str, length_m: float, max_25hz_m: float = MAX_LENGTH_M
+                  ) -> SectionCircuit:
+    """The live circuit of ``section``; a 25 Hz one longer than ``max_25hz_m`` (or the model's range) is held down."""
     sec = station.sections[section]
     if sec.type is CircuitType.axle_counter:
         return SectionCircuit(section, sec.type, length_m, AxleCounter())
     if sec.type is CircuitType.phase25hz:
-        params = adjusted_params(max(length_m, 1.0))
-        return SectionCircuit(section, sec.type, length_m, Phase25HzCircuit(max(length_m, 1.0), params))
+        length = max(length_m, 1.0)
+        limit = min(max_25hz_m, MAX_LENGTH_M)
+        circuit = SectionCircuit(section, sec.type, length_m,
+                                 Phase25HzCircuit(length, adjusted_params(length), beyond_range=True))
+        if length > limit:
+            circuit.held_down = (f"25 Hz section {section} is {length:g} m long, past the track-circuit model's "
+                                 f"range ({limit:g} m): a train on it might not drop its relay, so it is held "
+                                 "occupied; split it with an insulated joint")
+        return circuit
     from .zpw2000a import ZpwCircuit, capacitor_positions
 
     carrier = sec.carrier or "1700-1"

@@ -17,6 +17,9 @@ Capacitors are numbered 1..N from the section's lower end; positions are metres 
 
 The receiver gain is set per section as a maintainer sets the attenuator (衰耗器): the no-train main-track output at
 the design ballast with no fault is ``adjust_mV``. Figures and their sources: docs/zpw2000a.md.
+
+Ballast resistances <= 0 or NaN and positions that are not finite numbers raise ``ValueError`` (:mod:`.physical`);
+infinite ballast is dry ballast, with no leakage.
 """
 
 from __future__ import annotations
@@ -29,6 +32,8 @@ from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 import numpy.typing as npt
+
+from .physical import check_ballast, check_position, check_shunts
 
 if TYPE_CHECKING:
     from liansuo.stations.station import Station
@@ -87,6 +92,9 @@ class ZpwParams:
     # cab signal: minimum entry current with the standard shunt (station coding standard, commonly quoted)
     cab_min_mA: tuple[float, float, float, float] = (500.0, 500.0, 500.0, 450.0)
     profile_step_m: float = 10.0  # shunt positions for max residual / min cab current: every 10 m, ends included
+
+    def __post_init__(self) -> None:
+        check_ballast("ballast_ohm_km", self.ballast_ohm_km)
 
     def rail_impedance(self, carrier: str) -> complex:
         i = _base_index(carrier)
@@ -278,6 +286,8 @@ def sweep_section(length_m: float, capacitors_m: Sequence[float], carriers: Sequ
                   positions_m: Sequence[float] | None = None, params: ZpwParams = DEFAULT_PARAMS,
                   capacitance_uF: float | None = None) -> SweepResult:
     """Every configuration of one section at once; receiver gain set per carrier as ``ZpwCircuit`` sets it."""
+    for b in ballasts:
+        check_ballast("ballasts", b)
     caps = sorted(capacitors_m)
     cases = single_faults(len(caps)) if faults is None else list(faults)
     pos = profile_points(length_m, params.profile_step_m) if positions_m is None else np.asarray(positions_m, float)
@@ -309,6 +319,12 @@ class ZpwFaults:
     broken_rail_at_m: float | None = None  # metres from the section's lower end
     ballast_ohm_km: float | None = None  # wet / dirty ballast overriding the design value
     insulation_short: bool = False  # failed insulation across the rails at the receiver end (red band)
+
+    def __post_init__(self) -> None:
+        if self.ballast_ohm_km is not None:
+            check_ballast("ballast_ohm_km", self.ballast_ohm_km)
+        if self.broken_rail_at_m is not None:
+            check_position("broken_rail_at_m", self.broken_rail_at_m)
 
     def key(self) -> tuple[object, ...]:
         return (tuple(sorted(self.capacitors.items())), self.broken_rail_at_m, self.ballast_ohm_km,
@@ -350,8 +366,8 @@ class ZpwCircuit:
     def __init__(self, length_m: float, carrier: str, capacitor_positions_m: Sequence[float] = (),
                  params: ZpwParams = DEFAULT_PARAMS, *, capacitance_uF: float | None = None,
                  transmitter_end: End = "upper") -> None:
-        if length_m <= 0.0:
-            raise ValueError(f"section length must be positive, got {length_m} m")
+        if not (math.isfinite(length_m) and length_m > 0.0):
+            raise ValueError(f"length_m must be a positive number of metres, got {length_m!r}")
         if transmitter_end not in ("upper", "lower"):
             raise ValueError("transmitter_end is 'upper' or 'lower'")
         self.length_m = float(length_m)
@@ -431,8 +447,10 @@ class ZpwCircuit:
         return vrx, (None if lead is None else vrx * lead)
 
     def evaluate(self, shunts: Sequence[tuple[float, float]] = (), faults: ZpwFaults | None = None) -> ZpwState:
-        """Receiver state for wheelset shunts ``(metres from the section's lower end, ohm)``; outside ones ignored."""
+        """Receiver state for wheelset shunts ``(metres from the section's lower end, ohm)``; outside ones ignored, a
+        position that is not a finite number raises ``ValueError`` (such a wheelset lies nowhere)."""
         f = faults or NO_FAULTS
+        check_shunts(shunts)
         inside = [(x, r) for x, r in shunts if -1e-9 <= x <= self.length_m + 1e-9]
         if not inside:
             return self.adjustment(f)

@@ -6,6 +6,7 @@ Each command returns a :class:`Result`; a refusal says why.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 
 from liansuo.circuits.faults import KINDS, parse_fault
@@ -146,6 +147,9 @@ def _axles(sim: World, args: list[str]) -> Result:
             x = float(w)
         except ValueError:
             return Result.refuse(f"'{w}' is neither a track of {sim.station.id} nor a position in metres")
+        if not math.isfinite(x):
+            return Result.refuse(f"position '{w}' is not a number of metres: give where the wheelset stands, "
+                                 "e.g. 350.5")
         if not track:
             return Result.refuse(f"name the track before the positions: {USAGE['axles']}")
         lo, hi = sim.station.track_span(track)

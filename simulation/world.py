@@ -55,6 +55,8 @@ class World:
         self.parked: dict[str, list[Axle]] = {}  # named sets of wheelsets placed by hand (``axles`` command)
         self.events: deque[Event] = deque(maxlen=20_000)  # the world's own events: trains, faults
         self.alarms: dict[str, str] = {}  # the world's alarms (derailment, squeeze by a train)
+        for reason in self.field.held_down().values():  # sections past their track-circuit model's range
+            self.log("alarm", reason)
         motion = make_engine(engine, self.station, cycle_s)
         self.fleet = Fleet(self.station, self.field, lambda: self.view.outputs.signals, self.log, self.auto_limit,
                            engine=motion, rules=self.rules)

@@ -239,7 +239,9 @@ class _Warner:
             length = self.st.section_length(s.id)
             if s.type is CircuitType.phase25hz and length > self.r.phase25hz_max_length_m:
                 self.warn(self.loc("sections", s.id), f"25 Hz section '{s.id}' is {metres(length)} long "
-                          f"(limit about {metres(self.r.phase25hz_max_length_m)})", "split it with an insulated joint")
+                          f"(limit about {metres(self.r.phase25hz_max_length_m)}): in dry ballast a train on it "
+                          "might not drop its relay, so the simulation holds it occupied (red band)",
+                          "split it with an insulated joint")
             run = self.st.section_span(s.id)  # the track circuit's main run, not its branches added to it
             if (s.type is CircuitType.zpw2000a and run > self.r.capacitor_min_section_m
                     and (s.capacitors is None or s.capacitors.count == 0)):

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from typing import Protocol
 
@@ -82,6 +83,8 @@ def _train(sim: Yard, args: list[str]) -> Result:
                 nums[k] = float(params[k])
             except ValueError:
                 return Result.refuse(f"{k} must be a number, not '{params[k]}'")
+            if not math.isfinite(nums[k]):
+                return Result.refuse(f"{k} must be a finite number, not '{params[k]}'")
             if nums[k] <= 0 and k != "front":
                 return Result.refuse(f"{k} must be positive")
     mode = params.get("mode", "manual")
@@ -145,6 +148,8 @@ def _drive(sim: Yard, args: list[str]) -> Result:
         kmh = float(args[1])
     except ValueError:
         return Result.refuse(f"speed must be a number of km/h, not '{args[1]}'")
+    if not math.isfinite(kmh):
+        return Result.refuse(f"speed must be a finite number of km/h, not '{args[1]}'")
     tr = sim.fleet.trains[name]
     if kmh < 0:
         return Result.refuse("to drive the other way, 'stop' then 'reverse' the train")
