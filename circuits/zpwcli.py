@@ -1,5 +1,6 @@
-"""``liansuo zpw STATION [--fault SECTION:capacitor:N:open|half|short ...] [--format text|json|csv] [-o FILE]``:
-the command line of :mod:`.zpwfigures`."""
+"""``liansuo zpw STATION [--fault SECTION:capacitor:N:open|half|short ...] [--format text|json|csv] [-o FILE]
+[--plot FILE] [--plot-csv FILE] [--section ID]``: the command line of :mod:`.zpwfigures` (the table) and
+:mod:`.zpwplot` (the profiles along one section)."""
 
 from __future__ import annotations
 
@@ -14,7 +15,9 @@ from liansuo.stations.arguments import unwritable
 from liansuo.stations.exitcodes import Exit, bad_input, refuse
 from liansuo.stations.jsonreport import report
 from liansuo.stations.loader import load
+from liansuo.stations.plotfiles import add_plot_options, plot_problem, write_rows
 from liansuo.stations.source import StationError
+from liansuo.stations.station import Station
 
 from .zpwfigures import FAULT_FORM, FaultSpecError, as_text, collect_faults, section_rows, write_csv
 
@@ -22,12 +25,18 @@ from .zpwfigures import FAULT_FORM, FaultSpecError, as_text, collect_faults, sec
 def cmd_zpw(args: argparse.Namespace) -> int:
     if args.output and (why := unwritable(Path(args.output))):
         return refuse("zpw", why, Exit.USAGE)
+    if why := plot_problem(args):
+        return refuse("zpw", why, Exit.USAGE)
+    if args.section and not (args.plot or args.plot_csv):
+        return refuse("zpw", "--section chooses the section to plot: give --plot FILE or --plot-csv FILE with it",
+                      Exit.USAGE)
     try:
         station = load(args.station)
     except StationError as exc:
         return bad_input(exc)
     try:
         faults = collect_faults(station, args.fault)
+        plot = _plot_cases(station, args)
     except FaultSpecError as exc:
         return refuse("zpw", str(exc), Exit.USAGE)
     rows = section_rows(station, faults)
@@ -40,16 +49,41 @@ def cmd_zpw(args: argparse.Namespace) -> int:
                           indent=2) + "\n"
     else:
         text = as_text(station, rows) + "\n"
+    if plot is not None and (why := _write_plot(station, args, *plot)):
+        return refuse("zpw", why, Exit.USAGE)
+    wrote = [f for f in (args.plot, args.plot_csv) if f] if args.format == "text" else []
     if args.output is None:
         sys.stdout.write(text)
-        return 0
-    try:
-        Path(args.output).write_text(text, encoding="utf-8", newline="")
-    except OSError as exc:
-        return refuse("zpw", f"cannot write {args.output}: {exc.strerror or exc}; give -o a file in a folder you can "
-                      "write to", Exit.USAGE)
-    print(f"wrote {args.output}")
+    else:
+        try:
+            Path(args.output).write_text(text, encoding="utf-8", newline="")
+        except OSError as exc:
+            return refuse("zpw", f"cannot write {args.output}: {exc.strerror or exc}; give -o a file in a folder you "
+                          "can write to", Exit.USAGE)
+        wrote.insert(0, args.output)
+    for f in wrote:
+        print(f"wrote {f}")
     return 0
+
+
+def _plot_cases(station: Station, args: argparse.Namespace) -> tuple[str, list[dict[int, str]]] | None:
+    """The section to plot and its fault cases, or None when no plot is asked for."""
+    if not (args.plot or args.plot_csv):
+        return None
+    from .zpwplot import fault_cases, plotted_section
+
+    section = plotted_section(station, args.section, args.fault)
+    return section, fault_cases(station, section, args.fault)
+
+
+def _write_plot(station: Station, args: argparse.Namespace, section: str, cases: list[dict[int, str]]) -> str:
+    """The figure and its CSV; '' or why one could not be written."""
+    from .zpwplot import COLUMNS, draw, profiles, rows
+
+    profs = profiles(station, section, cases)
+    if args.plot_csv and (why := write_rows(args.plot_csv, COLUMNS, rows(section, profs))):
+        return why
+    return draw(station, section, profs, args.plot) if args.plot else ""
 
 
 def register(add: Callable[[str, Callable[[argparse.Namespace], int], str], argparse.ArgumentParser]) -> None:
@@ -60,3 +94,6 @@ def register(add: Callable[[str, Callable[[argparse.Namespace], int], str], argp
                     help="a compensation-capacitor fault (repeatable); capacitors are numbered from the lower end")
     sp.add_argument("--format", choices=("text", "json", "csv"), default="text", help="text (default), json or csv")
     sp.add_argument("-o", "--output", metavar="FILE", help="write to FILE instead of stdout")
+    add_plot_options(sp, "the shunt residual and the cab-signal current along one section, healthy and faulted")
+    sp.add_argument("--section", metavar="ID", help="the section to plot (default: the one the faults name, else the "
+                    "first ZPW-2000A section)")

@@ -12,7 +12,7 @@ import sys
 from collections.abc import Callable, Sequence
 
 from liansuo.bench import cli as bench
-from liansuo.circuits import zpwcli
+from liansuo.circuits import phase25cli, zpwcli
 from liansuo.cli import completion, schemas
 from liansuo.interlocking import cli as interlocking
 from liansuo.proving import cli as proving
@@ -31,6 +31,7 @@ REGISTER: tuple[Callable[[Add], None], ...] = (
     schemas.register,  # schema
     interlocking.register,  # table
     zpwcli.register,  # zpw
+    phase25cli.register,  # 25hz
     proving.register_run,  # run
     proving.register,  # test
     verify.register,  # verify

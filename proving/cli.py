@@ -1,5 +1,6 @@
 """``liansuo test FILE... [-k TEXT] [-v] [--format text|json] [--junit-xml FILE]``: run YAML route-test scripts;
-``liansuo run SCENARIO [--until DURATION] [--engine kinematic|sumo] [--format text|json]``: run a scenario headless.
+``liansuo run SCENARIO [--until DURATION] [--engine kinematic|sumo] [--format text|json] [--plot FILE]
+[--plot-csv FILE]``: run a scenario headless (and plot its trains, :mod:`.trainplot`).
 
 Every file is read and every station loaded before anything runs, so a bad input stops the command with exit
 status 3 and nothing run or written (docs/commands.md, "Exit status").
@@ -20,12 +21,15 @@ from liansuo.stations.arguments import unwritable
 from liansuo.stations.exitcodes import Exit, bad_input, refuse
 from liansuo.stations.fit import fit_all
 from liansuo.stations.jsonreport import print_report
+from liansuo.stations.plotfiles import add_plot_options, plot_problem, write_rows
 from liansuo.stations.source import StationError
 from liansuo.stations.station import Station
 
 from .junit import write_junit
 from .scenario import ScenarioLog, parse_scenario, run_scenario, station_of
 from .scripts import Outcome, Script, Unrunnable, parse_script, run_script, script_station, selected
+from .trainplot import COLUMNS as TRACE_COLUMNS
+from .trainplot import TrainTrace, draw
 
 Add = Callable[..., argparse.ArgumentParser]
 FORMATS = ("text", "json")
@@ -101,6 +105,8 @@ def cmd_run(args: argparse.Namespace) -> int:
             until = parse_duration(args.until)
         except ValueError as exc:
             return refuse("run", f"--until {args.until}: {exc}", Exit.USAGE)
+    if why := plot_problem(args):
+        return refuse("run", why, Exit.USAGE)
     try:
         sc = parse_scenario(Path(args.scenario))
     except StationError as exc:
@@ -111,11 +117,22 @@ def cmd_run(args: argparse.Namespace) -> int:
         return bad_input(exc, f"station of {args.scenario}")
     log = ScenarioLog()
     text: list[str] | None = [] if args.format == "json" else None  # the text log is not printed with JSON
+    trace = TrainTrace() if args.plot or args.plot_csv else None
     try:
-        status, sim = run_scenario(sc, until, text, engine=args.engine, log=log, station=station)
+        status, sim = run_scenario(sc, until, text, engine=args.engine, log=log, station=station,
+                                   watch=trace.attach if trace else None)
     except (SumoUnavailable, SumoExportError, SumoEngineError) as exc:  # the SUMO engine could not start
         return refuse(f"run --engine {args.engine}", str(exc), Exit.USAGE)
     sim.close()
+    if trace is not None:
+        if args.plot_csv and (why := write_rows(args.plot_csv, TRACE_COLUMNS, trace.rows)):
+            return refuse("run", why, Exit.USAGE)
+        if args.plot and (why := draw(trace, f"{Path(sc.file).name}: the trains of {sc.station}", args.plot)):
+            return refuse("run", why, Exit.USAGE)
+        if args.format == "text":
+            for f in (args.plot, args.plot_csv):
+                if f:
+                    print(f"wrote {f}")
     if args.format == "json":
         print_report("run", status == 0, {"scenario": sc.file, "station": sc.station, "engine": args.engine,
                                           "events": log.events, "problems": log.problems,
@@ -136,6 +153,7 @@ def register_run(add: Add) -> None:
                     help="what moves the trains: the built-in kinematic model (default) or Eclipse SUMO "
                          "(pip install 'liansuo[sumo]'; see docs/sumo.md)")
     sp.add_argument("--format", choices=FORMATS, default="text", help="text (default: the event log) or json")
+    add_plot_options(sp, "time-distance and speed-distance plots of the trains")
 
 
 def register(add: Add) -> None:

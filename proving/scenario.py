@@ -15,6 +15,7 @@ interlocking and of the world is printed as the run goes.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -77,11 +78,15 @@ def station_of(sc: Scenario) -> Station:
 
 def run_scenario(sc: Scenario, until_s: float | None = None, out: list[str] | None = None,
                  engine: str = "kinematic", log: ScenarioLog | None = None,
-                 station: Station | None = None) -> tuple[int, Simulation]:
+                 station: Station | None = None, watch: Callable[[Simulation], None] | None = None,
+                 ) -> tuple[int, Simulation]:
     """Run the scenario; returns (exit status, the simulation). Lines of the event log go to ``out`` (or stdout),
     and the same as data to ``log`` when one is given. ``engine``: the train engine, "kinematic" or "sumo" (see
-    :class:`Simulation`); ``station``: the scenario's station when already loaded."""
+    :class:`Simulation`); ``station``: the scenario's station when already loaded; ``watch``: called with the
+    simulation before the first step (to attach a recorder, e.g. :class:`~.trainplot.TrainTrace`)."""
     sim = Simulation(station or station_of(sc), engine=engine)
+    if watch is not None:
+        watch(sim)
     seen = [0, 0]  # events already printed from the interlocking and from the world
     log = log if log is not None else ScenarioLog()
 

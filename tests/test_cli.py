@@ -16,8 +16,8 @@ import pytest
 
 from liansuo.cli.main import build_parser
 
-SUBCOMMANDS = {"stations", "check", "schema", "generate", "table", "zpw", "run", "test", "verify", "soak", "mutate",
-               "bench", "tui", "replay", "completion"}
+SUBCOMMANDS = {"stations", "check", "schema", "generate", "table", "zpw", "25hz", "run", "test", "verify", "soak",
+               "mutate", "bench", "tui", "replay", "completion"}
 
 
 def test_every_subcommand_is_registered() -> None:

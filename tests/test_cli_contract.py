@@ -61,6 +61,7 @@ def envelope_of(out: str, command: str, ok: bool = True) -> dict[str, object]:
     ("check", ["check", "jiaopei"], "turnouts"),
     ("table", ["table", "jiaopei"], "routes"),
     ("zpw", ["zpw", "gaotie"], "sections"),
+    ("25hz", ["25hz", "jiaopei", "--section", "IG"], "points"),
     ("test", ["test", str(SCRIPT), "-k", "guide signal"], "tests"),
     ("run", ["run", str(SCENARIO)], "events"),
     ("verify", ["verify", "jiaopei", "--route", "X-XI", "--no-pairs"], "route_results"),

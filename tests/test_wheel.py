@@ -5,8 +5,8 @@ The rest of the suite runs against the editable install, where the checkout itse
 missing from ``[tool.setuptools.package-data]``, a layer folder without ``__init__.py`` or a top-level package that
 should not be installed would all pass there and break ``pip install liansuo``. Here the installed ``liansuo`` runs
 ``verify``, a route-test script, ``table``, the Python API, a bundled exercise, the console headless, the pytest
-plugin, ``--version``, ``completion`` and the shipped JSON Schemas; a failure names the command that failed, its
-folder, exit status, stdout and stderr.
+plugin, ``--version``, ``completion``, the shipped JSON Schemas and ``--plot`` without the ``plot`` extra; a failure
+names the command that failed, its folder, exit status, stdout and stderr.
 
 One build and one virtual environment serve every test of a run (a session fixture; some 20 s of CPU in all). Select
 with ``pytest -m wheel``, leave out with ``-m 'not wheel'``. The only skip: no package index is reachable and pip's
@@ -393,3 +393,16 @@ def test_version_completion_and_the_shipped_schemas(installed: Installed) -> Non
         assert Path(path).resolve().is_relative_to(installed.venv.resolve()), f"{kind} schema not installed: {path}"
         printed = must(f"liansuo schema {kind}", [installed.liansuo, "schema", kind], installed.work, installed.env)
         assert printed == Path(path).read_text(encoding="utf-8"), f"liansuo schema {kind} differs from {path}"
+
+
+def test_a_plot_without_the_plot_extra_says_how_to_get_it(installed: Installed) -> None:
+    """The wheel's own dependencies leave matplotlib out: --plot then stops with one line and exit status 2, while
+    --plot-csv, which needs nothing more, is written."""
+    proc = run([installed.liansuo, "zpw", "gaotie", "--plot", "x2jg.png"], installed.work, installed.env)
+    assert proc.returncode == 2, describe(proc, installed.work)
+    assert proc.stderr == "liansuo zpw: the plots need matplotlib: pip install 'liansuo[plot]'\n", proc.stderr
+    assert not (installed.work / "x2jg.png").exists()
+    must("liansuo zpw gaotie --plot-csv x2jg.csv",
+         [installed.liansuo, "zpw", "gaotie", "--section", "X2JG", "--plot-csv", "x2jg.csv"], installed.work,
+         installed.env)
+    assert (installed.work / "x2jg.csv").read_text(encoding="utf-8").startswith("section,case,position_m,")
