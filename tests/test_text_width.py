@@ -39,7 +39,8 @@ def test_check_fits_100_columns(station: str) -> None:
     assert too_wide(out) == []
 
 
-@pytest.mark.parametrize("args", [("stations",), ("zpw", "gaotie"), ("verify", "examples/stations/minimal.yaml"),
+@pytest.mark.parametrize("args", [("stations",), ("zpw", "gaotie"), ("25hz", "jiaopei", "--section", "IG"),
+                                  ("verify", "examples/stations/minimal.yaml"),
                                   ("soak", "jiaopei", "--steps", "150"),
                                   ("run", "examples/scenarios/jiaopei-receive-depart.yaml"),
                                   ("test", "examples/scripts/jiaopei-interlocking-test.yaml"),
