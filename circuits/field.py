@@ -5,7 +5,9 @@ lamps light as commanded, and track circuits follow the wheelsets standing on th
 and trains, :mod:`.shunts`) and the teaching panel's switch K (``occupy`` / ``vacate``). Relay states are read
 through the ``track_up``, ``indication``, ``lamp_proven``, ``flasher_ok`` and ``doors`` methods; ``take_changes``
 says what changed since it was last called, so the one reading them copies only that. Faults are injected with
-``inject`` and removed with ``repair`` (``circuits.faults`` parses them).
+``inject`` and removed with ``repair`` (``circuits.faults`` parses them). Traction current leaking through a long
+dead zone (``set_leakage``) makes a section's relay flicker down in a pattern driven by the field's time
+(:mod:`.leakage`).
 """
 
 from __future__ import annotations
@@ -21,6 +23,7 @@ from .doors import PlatformDoors
 from .faults import Fault
 from .flasher import ElectronicFlasher, RelayFlasher
 from .lamps import SignalLamps
+from .leakage import Flicker
 from .machines import SwitchMachine
 from .railgeometry import Axle, geometry_of
 from .shunts import OnTrack, SectionShunts, Shunt, WheelsetGroup, changed_sections
@@ -75,6 +78,9 @@ class Field:
         self._settled: set[str] = set()  # sections whose circuits are down by a standard shunt (``shunted_down``)
         self._listed: dict[str, list[Shunt]] = {}  # the shunts each other section was last evaluated with
         self.cab_codes: dict[str, str | None] = {}
+        self.t = 0.0  # the field's simulated time: the sum of its steps
+        self.fault_stamp = 0  # counts the faults injected and repaired: what reads the circuits can tell a change
+        self.flicker = Flicker()  # traction leakage through long dead zones (``set_leakage``)
         self._driven: set[str] = set()  # machines with a drive command outstanding
         self._moving: set[str] = set()
         self.stamp = 0  # counts the batches of changes taken: what reads the field can tell when nothing changed
@@ -109,6 +115,21 @@ class Field:
         self.on_track.loose, self.on_track.groups = loose, groups
         for sec in touched:
             self._reevaluate(sec, if_changed=True)
+
+    def set_leakage(self, sections: Iterable[str]) -> None:
+        """The sections that take traction current leaking through a long dead zone from now on (:mod:`.leakage`);
+        their relays flicker down while it lasts (axle-counter sections are not touched)."""
+        wanted = {s for s in sections if self.circuits[s].counter is None}
+        for sec in self.flicker.leak(wanted, self.t):
+            self._flick(sec)
+
+    def _flick(self, section: str) -> None:
+        """Hold the section's relay down, or let it go, as the leakage pattern says now."""
+        c = self.circuits[section]
+        down = self.flicker.down(section, self.t)
+        if c.leak_drop != down:
+            c.leak_drop = down
+            self._reevaluate(section)
 
     def held_down(self) -> dict[str, str]:
         """Sections whose track relay is held down for good (past their model's range), with the reason."""
@@ -189,6 +210,9 @@ class Field:
                 counter.reset(self.circuits[sec].inside)
                 self._reevaluate(sec)
         cmd.axle_resets.clear()
+        self.t += dt
+        for sec in self.flicker.since:
+            self._flick(sec)
 
     def _relight(self, signal: str, lit: set[str]) -> None:
         before = self.lamps[signal].proving()
@@ -257,6 +281,7 @@ class Field:
         why = self._apply(fault, on=True)
         if not why:
             self.faults[(fault.kind, fault.target)] = fault
+            self.fault_stamp += 1
         return why
 
     def repair(self, kind: str, target: str) -> str:
@@ -266,6 +291,7 @@ class Field:
         why = self._apply(fault, on=False)
         if not why:
             del self.faults[(kind, target)]
+            self.fault_stamp += 1
         return why
 
     def _apply(self, f: Fault, *, on: bool) -> str:

@@ -54,6 +54,7 @@ class SectionCircuit:
         self.model = model
         self.faults = SectionFaults()
         self.k_switch = False  # the teaching panel's switch K shorting the track
+        self.leak_drop = False  # traction leakage through a long dead zone holds the relay down now (:mod:`.leakage`)
         self.held_down = ""  # why the relay is held down for good (a section past its model's range), or ''
         self.up = False  # fail-safe until first evaluated
         self._voltage = 0.0  # V for 25 Hz, mV for ZPW-2000A
@@ -121,7 +122,7 @@ class SectionCircuit:
         listed = shunts.listed()
         self._inside = len(listed)
         self._evaluate(listed)
-        if self.k_switch or self.held_down:
+        if self.k_switch or self.held_down or self.leak_drop:
             self.up = False
         return self.up
 

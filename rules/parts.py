@@ -69,6 +69,7 @@ class DesignRules(Part):
     dead_zone_spacing_min_m: Metres
     dead_zone_spacing_relaxed_m: Metres
     dead_zone_short_m: Metres
+    dead_zone_long_m: Metres
     fouling_clearance_m: Metres
     fouling_clearance_emu_m: Metres
     cab_code_min_time_s: Seconds

@@ -1,4 +1,4 @@
-"""The scripts' checks, ``expect signal|route|turnout|section|refused|accepted|alarm|no-alarm|block-line|code ...``.
+"""The scripts' checks, ``expect signal|route|turnout|section|refused|accepted|alarm|no-alarm|block-line|code|cab ...``.
 
 Each compares what the world shows now (through its query API) with what the script expects and says what it saw.
 """
@@ -11,7 +11,8 @@ from liansuo.interlocking.state import RouteStage
 from .language import Command
 from .world import World
 
-USAGE = "expect signal|route|turnout|section|refused|accepted|alarm|no-alarm|block-line|code|odometry ..."
+USAGE = "expect signal|route|turnout|section|refused|accepted|alarm|no-alarm|block-line|code|cab|odometry ..."
+CAB_WORDS = ("none", "lost", "wrong-carrier")  # what 'expect cab' takes besides a code
 
 
 # the stages of a route (interlocking/state.py) and 'released': what 'expect route' may ask for
@@ -94,7 +95,27 @@ def _expect(sim: World, args: list[str]) -> Result:
         shown = sim.view.cab_code(s) or "none"
         return Result(shown == want, f"section {s} carries code {shown}" + ("" if shown == want else
                                                                               f", expected {want}"))
+    if what == "cab" and len(rest) == 2:
+        return _cab(sim, *rest)
     return Result.refuse(f"usage: {USAGE}")
+
+
+def _cab(sim: World, train: str, want: str) -> Result:
+    """``expect cab TRAIN CODE|none|lost|wrong-carrier``: what the train's cab signal reads."""
+    if train not in sim.fleet.trains:
+        return Result.refuse(f"there is no train '{train}' in the yard")
+    cab = sim.train_view(train).cab
+    shown = cab.state if cab.state in CAB_WORDS else str(cab.code)
+    parts = [f"the cab of {train} reads {shown}"]
+    if cab.section is not None:
+        parts.append(f"on {cab.section}")
+    if cab.carrier is not None:
+        parts.append(f"carrier {cab.carrier}")
+    if cab.level_mA is not None:
+        parts.append(f"{cab.level_mA:g} mA")
+    if cab.atp_braking:
+        parts.append("(ATP braking)")
+    return Result(shown == want, " ".join(parts) + ("" if shown == want else f", expected {want}"))
 
 
 def _mentions(message: str, text: str) -> bool:

@@ -94,6 +94,24 @@ class AlarmView:
 
 
 @dataclass(frozen=True)
+class CabView:
+    """A train's cab signal (机车信号): ``state`` none (no code to read), code, lost (掉码, under the carrier's
+    minimum current) or wrong-carrier (串码, in a long dead zone), the section under the leading wheelset, the
+    low-frequency code and carrier read, the code current (mA) where the ZPW-2000A model gives one, and whether the
+    ATP is braking the train (an emergency stop from ``atp`` until released)."""
+
+    state: str = "none"
+    section: str | None = None
+    code: str | None = None
+    carrier: str | None = None
+    level_mA: float | None = None
+    atp_braking: bool = False
+
+
+NO_CAB = CabView()
+
+
+@dataclass(frozen=True)
 class TrainView:
     """What a front end shows of a train: its name, the sections its wheelsets shunt, speed and direction, and where
     its head is. A train whose head has run out over the station's boundary has no position in the station: it is
@@ -107,6 +125,7 @@ class TrainView:
     head_track: str | None  # the track of the leading wheelset; None once the head is beyond the boundary
     head_m: float | None  # position of the leading wheelset along the line; None once beyond the boundary
     state: str = "running"  # running, derailed, leaving (head beyond the boundary, rear still in), left
+    cab: CabView = NO_CAB  # the cab signal
 
     @property
     def left(self) -> bool:

@@ -24,12 +24,13 @@ from liansuo.stations.loader import load
 from liansuo.stations.station import Station
 
 from .neighbour import Neighbours
+from .trains.cabsignal import ATP
 from .trains.engine import MotionEngine
 from .trains.engines import attach_engine, make_engine
 from .trains.fleet import Fleet, Train
 from .trains.movement import OUTSIDE
 from .unknown import UnknownId, close_matches
-from .view import AlarmView, InterlockingView, TrainView
+from .view import AlarmView, CabView, InterlockingView, TrainView
 from .wiring import Wiring
 
 
@@ -114,8 +115,10 @@ class World:
         self.update_axles()
 
     def update_axles(self) -> None:
-        """Tell the field where every wheelset stands: trains and parked wheelsets."""
+        """Tell the field where every wheelset stands (trains and parked wheelsets) and where the trains' traction
+        current leaks through long dead zones."""
         self.field.set_axles([a for group in self.parked.values() for a in group], self.fleet.wheelsets())
+        self.field.set_leakage(self.fleet.leaking())
 
     def doors(self, platform: str, action: str) -> Result:
         """Open or close a platform's screen doors through the interlocking (the ``doors`` command, the ATO)."""
@@ -185,9 +188,11 @@ class World:
     def _train_view(self, tr: Train) -> TrainView:
         track, x = self.fleet.front(tr)
         sections, speed = self.fleet.sections_of(tr), round(tr.speed_kmh, 2)
+        r = tr.cab.reading
+        cab = CabView(r.state, r.section, r.code, r.carrier, r.level_mA, ATP in tr.estops.active)
         if track == OUTSIDE:  # the head has run out over the boundary; the rear is still in
-            return TrainView(tr.name, sections, speed, tr.direction.value, tr.mode, None, None, "leaving")
-        return TrainView(tr.name, sections, speed, tr.direction.value, tr.mode, track, round(x, 2), tr.state)
+            return TrainView(tr.name, sections, speed, tr.direction.value, tr.mode, None, None, "leaving", cab)
+        return TrainView(tr.name, sections, speed, tr.direction.value, tr.mode, track, round(x, 2), tr.state, cab)
 
     def alarm_views(self) -> list[AlarmView]:
         """Active alarms: the interlocking's, then the world's."""

@@ -105,6 +105,7 @@ def _train(sim: Yard, args: list[str]) -> Result:
         sim.fleet.remove(name)
         return Result.refuse("movement must be train or shunt")
     tr.shunting = movement == "shunt"
+    tr.traction = kind != "trolley"
     if "stop" in params:
         why = sim.fleet.set_platform_stop(tr, params["stop"])
         if why:

@@ -2,7 +2,10 @@
 
 Each step every train picks a target speed from its driver, accelerates or brakes towards it, moves, and the field
 is told where every wheelset stands, so the track circuits (and through them the interlocking) see the trains: as
-the sections each train shunts, worked out again only when they can have changed (:mod:`.wheelsets`).
+the sections each train shunts, worked out again only when they can have changed (:mod:`.wheelsets`). Every train's
+cab signal reads the code at its leading wheelset, and the ATP brakes on a lost code or a wrong carrier
+(:mod:`.cabsignal`); a train with wheelsets in a long dead zone leaks traction current into the next section
+(:mod:`.traction`).
 """
 
 from __future__ import annotations
@@ -11,17 +14,20 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from liansuo.circuits.field import Field
+from liansuo.circuits.leakage import long_dead_zones
 from liansuo.circuits.railgeometry import Axle
 from liansuo.rules import RuleSet, load_rules
 from liansuo.stations.schema import Direction, Marker
 from liansuo.stations.station import Station
 
 from .autoshunt import EmergencyStops
+from .cabsignal import ATP, CabReader, CabReading, CabSignal
 from .consist import Consist
 from .drivers import Lookout, look_ahead, stopping_speed, target_speed
 from .engine import KinematicEngine, MotionEngine
 from .movement import OUTSIDE, Notify, Position, Track
 from .odometry import Odometer
+from .traction import leaking_sections
 from .wheelsets import TrainWheelsets, wheelsets_now
 
 MODES = ("manual", "signal", "auto")
@@ -67,6 +73,8 @@ class Train:
     slip_from: float = 0.0
     slip_until: float = 0.0
     extra: dict[str, object] = field(default_factory=dict)
+    traction: bool = True  # draws traction current (a track trolley does not)
+    cab: CabSignal = field(default_factory=CabSignal, repr=False, compare=False)  # the cab signal (机车信号)
     wheelsets: TrainWheelsets | None = field(default=None, repr=False, compare=False)  # as the field last took them
 
     @property
@@ -104,6 +112,8 @@ class Fleet:
         self.field = fld
         self.track = Track(station, fld)
         self.lookout = Lookout(station, self.rules)  # what drivers look out for, sorted out once
+        self.long_zones = long_dead_zones(station, self.rules.design.dead_zone_long_m)  # by track
+        self.cabs = CabReader(station, fld, self.track, self.long_zones, WHEEL_OHM)
         self.tags: dict[str, list[Marker]] = {}  # balises and RFID tags by track, in the station's order
         for mk in station.model.markers:
             if mk.kind.value in ("balise", "rfid"):
@@ -158,6 +168,21 @@ class Fleet:
                 moving.speed_ms = speed
                 self._odometry(moving, dt, ds, accel)
                 self._move(moving, ds)
+        for tr in list(self.trains.values()):
+            if tr.state not in ("derailed", "left") and self.cabs.update(tr) is not None:  # its state changed
+                self._atp(tr, tr.cab.reading)
+
+    def _atp(self, tr: Train, reading: CabReading) -> None:
+        """The ATP brakes a train movement to a stand when its cab loses the code or reads a wrong carrier."""
+        if not reading.failed or tr.shunting or ATP in tr.estops.active:
+            return
+        tr.estops.apply(ATP, reading.why)
+        self.notify("train", f"train {tr.name}: ATP brakes to a stand: {reading.why}")
+        self.notify("alarm", f"ATP braked train {tr.name}: {reading.why}")
+
+    def leaking(self) -> set[str]:
+        """The sections taking traction current leaking through long dead zones from the trains' wheelsets."""
+        return leaking_sections(self.track, self.long_zones, self.trains.values()) if self.long_zones else set()
 
     def _odometry(self, tr: Train, dt: float, ds: float, accel: float) -> None:
         """Feed the on-board odometer: the wheels turn at the train's speed, faster while slipping, slower while
