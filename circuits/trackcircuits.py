@@ -175,10 +175,13 @@ def build_circuit(station: Station, section: str, length_m: float, max_25hz_m: f
                                  f"range ({limit:g} m): a train on it might not drop its relay, so it is held "
                                  "occupied; split it with an insulated joint")
         return circuit
-    from .zpw2000a import ZpwCircuit, capacitor_positions
+    from .zpw2000a import capacitor_positions
+    from .zpwadjust import adjusted_circuit
 
     carrier = sec.carrier or "1700-1"
-    model = ZpwCircuit(max(length_m, 1.0), carrier, capacitor_positions(station, section))
+    caps = sec.capacitors
+    model = adjusted_circuit(max(length_m, 1.0), carrier, capacitor_positions(station, section),
+                             capacitance_uF=caps.capacitance_uF if caps else None)
     return SectionCircuit(section, sec.type, length_m, model)
 
 

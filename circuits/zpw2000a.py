@@ -76,7 +76,8 @@ class ZpwParams:
     capacitor_min_section_m: float = 300.0  # Luo Ying 2023 (docs/references.md): only sections over 300 m
     capacitor_short_ohm: float = 0.01  # a shorted capacitor (modelled)
     # transmitter end (typical: level-1 output 161-170 V, 1:9 matching transformer; impedances modelled)
-    transmitter_V: float = 170.0
+    transmitter_V: float = 170.0  # the level in use (the adjustment table chooses it: circuits/zpwadjust.py)
+    transmitter_levels_V: tuple[float, float, float, float, float] = (170.0, 154.0, 135.0, 111.5, 79.5)  # levels 1-5
     matching_ratio: float = 9.0  # equipment side : rail side
     source_ohm: complex = complex(300.0, 0.0)  # transmitter output + cable, equipment side
     receiver_ohm: complex = complex(800.0, 0.0)  # receiver input + cable, equipment side

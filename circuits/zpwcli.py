@@ -16,7 +16,7 @@ from liansuo.stations.exitcodes import Exit, bad_input, refuse
 from liansuo.stations.jsonreport import report
 from liansuo.stations.loader import load
 from liansuo.stations.plotfiles import add_plot_options, plot_problem, write_rows
-from liansuo.stations.source import StationError
+from liansuo.stations.source import Diagnostic, StationError
 from liansuo.stations.station import Station
 
 from .zpwfigures import FAULT_FORM, FaultSpecError, as_text, collect_faults, section_rows, write_csv
@@ -84,6 +84,16 @@ def _write_plot(station: Station, args: argparse.Namespace, section: str, cases:
     if args.plot_csv and (why := write_rows(args.plot_csv, COLUMNS, rows(section, profs))):
         return why
     return draw(station, section, profs, args.plot) if args.plot else ""
+
+
+def check_warnings(station: Station) -> list[Diagnostic]:
+    """``liansuo check``'s warnings for ZPW-2000A sections the adjustment table cannot adjust (:mod:`.zpwadjust`);
+    numpy loads only for a station with ZPW-2000A sections."""
+    if not any(s.type.value == "zpw2000a" and s.carrier is not None for s in station.model.sections):
+        return []
+    from .zpwadjust import station_warnings
+
+    return station_warnings(station)
 
 
 def register(add: Callable[[str, Callable[[argparse.Namespace], int], str], argparse.ArgumentParser]) -> None:

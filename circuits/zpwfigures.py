@@ -60,7 +60,8 @@ def collect_faults(station: Station, specs: Sequence[str]) -> dict[str, dict[int
 
 def section_rows(station: Station, faults: dict[str, dict[int, str]] | None = None) -> list[dict[str, Any]]:
     """One row per ZPW-2000A section, in file order, with the fault applied where one is given."""
-    from .zpw2000a import ZpwFaults, fault_label, section_circuit
+    from .zpw2000a import ZpwFaults, fault_label
+    from .zpwadjust import section_circuit
 
     rows = []
     for sid in zpw_sections(station):

@@ -68,7 +68,7 @@ def fault_cases(station: Station, section: str, faults: Sequence[str]) -> list[d
             cases.append({number: mode})
     if faults:
         return cases
-    from .zpw2000a import section_circuit
+    from .zpwadjust import section_circuit
 
     circuit = section_circuit(station, section)
     opens = [{k: "open"} for k in range(1, len(circuit.capacitors_m) + 1)]
@@ -98,7 +98,8 @@ def _worst(circuit: Any, cases: list[dict[int, str]]) -> list[dict[int, str]]:
 
 def profiles(station: Station, section: str, cases: Sequence[dict[int, str]]) -> list[Profile]:
     """The healthy profile, then one per fault case."""
-    from .zpw2000a import ZpwFaults, fault_label, section_circuit
+    from .zpw2000a import ZpwFaults, fault_label
+    from .zpwadjust import section_circuit
 
     circuit = section_circuit(station, section)
     out = []
@@ -121,7 +122,7 @@ def draw(station: Station, section: str, profs: Sequence[Profile], path: str) ->
     """The figure: residual over cab current, one line per case, the relay's levels and the cab minimum; '' or why
     it could not be written."""
     from .zpw2000a import DEFAULT_PARAMS as P
-    from .zpw2000a import section_circuit
+    from .zpwadjust import section_circuit
 
     circuit = section_circuit(station, section)
     fig, (top, bottom) = new_figure(2, 1, sharex=True)

@@ -10,6 +10,7 @@ from __future__ import annotations
 import argparse
 import sys
 from collections.abc import Callable, Sequence
+from functools import partial
 
 from liansuo.bench import cli as bench
 from liansuo.circuits import phase25cli, zpwcli
@@ -27,7 +28,7 @@ Add = Callable[[str, Handler, str], argparse.ArgumentParser]
 
 # in the order of the help: the station, its table and track circuits, proving it, timing it, the console
 REGISTER: tuple[Callable[[Add], None], ...] = (
-    stations.register,  # stations, check, generate
+    partial(stations.register, more_warnings=(zpwcli.check_warnings,)),  # stations, check, generate
     schemas.register,  # schema
     interlocking.register,  # table
     zpwcli.register,  # zpw

@@ -14,11 +14,13 @@ from .fit import fit
 from .jsonreport import print_report
 from .library import bundled, describe
 from .loader import load
-from .source import StationError
+from .source import Diagnostic, StationError
+from .station import Station
 from .summary import summarise, summary_text
 
 Add = Callable[..., argparse.ArgumentParser]
 FORMATS = ("text", "json")
+Warnings = Callable[[Station], list[Diagnostic]]
 
 
 def cmd_stations(args: argparse.Namespace) -> int:
@@ -43,6 +45,8 @@ def cmd_check(args: argparse.Namespace) -> int:
                           f"{len(exc.diagnostics) - 1} more); the station was not loaded" if first else
                           "the station was not loaded", Exit.BAD_INPUT)
         return bad_input(exc)
+    for more in args.more_warnings:  # checks of the layers above, handed in by the command line (cli/main.py)
+        station.warnings = [*station.warnings, *more(station)]
     if args.format == "json":
         print_report("check", True, summarise(station))
     else:
@@ -78,10 +82,13 @@ def cmd_generate(args: argparse.Namespace) -> int:
     return 0
 
 
-def register(add: Add) -> None:
+def register(add: Add, more_warnings: tuple[Warnings, ...] = ()) -> None:
+    """Add ``stations``, ``check`` and ``generate``; ``more_warnings``: design checks of higher layers that
+    ``check`` adds to the station's own (the track-circuit physics: ``circuits/zpwcli.py``)."""
     sp = add("stations", cmd_stations, "list the bundled stations")
     sp.add_argument("--format", choices=FORMATS, default="text", help="text (default) or json")
     sp = add("check", cmd_check, "validate a station file and summarise it")
+    sp.set_defaults(more_warnings=more_warnings)
     sp.add_argument("station", help="bundled station name or path to a station YAML file")
     sp.add_argument("--format", choices=FORMATS, default="text", help="text (default) or json")
     sp = add("generate", cmd_generate, "write a generated station file (a hub of any size, for stress tests)")

@@ -14,7 +14,8 @@ import pytest
 
 from liansuo.circuits.phase25hz import Phase25HzFaults
 from liansuo.circuits.phase25sweep import section_model
-from liansuo.circuits.zpw2000a import ZpwFaults, section_circuit
+from liansuo.circuits.zpw2000a import ZpwFaults
+from liansuo.circuits.zpwadjust import section_circuit  # as `liansuo zpw` adjusts it (the table)
 from liansuo.cli.main import main
 from liansuo.stations.loader import load
 from liansuo.stations.plotfiles import NEED_MATPLOTLIB
