@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import sys
 from collections.abc import Callable
 from pathlib import Path
 
@@ -13,6 +12,7 @@ from liansuo.stations.arguments import unwritable
 from liansuo.stations.exitcodes import Exit, bad_input, refuse
 from liansuo.stations.jsonreport import report
 from liansuo.stations.loader import load
+from liansuo.stations.output import deliver
 from liansuo.stations.plotfiles import add_plot_options, plot_problem, write_rows
 from liansuo.stations.source import StationError
 
@@ -48,19 +48,8 @@ def cmd_25hz(args: argparse.Namespace) -> int:
             ), ensure_ascii=False, indent=2) + "\n"
     else:
         text = sweeps.as_text(station, args.section, model, shown) + "\n"
-    wrote = [f for f in (args.plot, args.plot_csv) if f] if args.format == "text" else []
-    if args.output is None:
-        sys.stdout.write(text)
-    else:
-        try:
-            Path(args.output).write_text(text, encoding="utf-8", newline="")
-        except OSError as exc:
-            return refuse("25hz", f"cannot write {args.output}: {exc.strerror or exc}; give -o a file in a folder you "
-                          "can write to", Exit.USAGE)
-        wrote.insert(0, args.output)
-    for f in wrote:
-        print(f"wrote {f}")
-    return 0
+    also = [f for f in (args.plot, args.plot_csv) if f] if args.format == "text" else []
+    return deliver("25hz", text, args.output, also)
 
 
 def register(add: Callable[[str, Callable[[argparse.Namespace], int], str], argparse.ArgumentParser]) -> None:

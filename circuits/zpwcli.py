@@ -7,7 +7,6 @@ from __future__ import annotations
 import argparse
 import io
 import json
-import sys
 from collections.abc import Callable
 from pathlib import Path
 
@@ -15,6 +14,7 @@ from liansuo.stations.arguments import unwritable
 from liansuo.stations.exitcodes import Exit, bad_input, refuse
 from liansuo.stations.jsonreport import report
 from liansuo.stations.loader import load
+from liansuo.stations.output import deliver
 from liansuo.stations.plotfiles import add_plot_options, plot_problem, write_rows
 from liansuo.stations.source import Diagnostic, StationError
 from liansuo.stations.station import Station
@@ -51,19 +51,8 @@ def cmd_zpw(args: argparse.Namespace) -> int:
         text = as_text(station, rows) + "\n"
     if plot is not None and (why := _write_plot(station, args, *plot)):
         return refuse("zpw", why, Exit.USAGE)
-    wrote = [f for f in (args.plot, args.plot_csv) if f] if args.format == "text" else []
-    if args.output is None:
-        sys.stdout.write(text)
-    else:
-        try:
-            Path(args.output).write_text(text, encoding="utf-8", newline="")
-        except OSError as exc:
-            return refuse("zpw", f"cannot write {args.output}: {exc.strerror or exc}; give -o a file in a folder you "
-                          "can write to", Exit.USAGE)
-        wrote.insert(0, args.output)
-    for f in wrote:
-        print(f"wrote {f}")
-    return 0
+    also = [f for f in (args.plot, args.plot_csv) if f] if args.format == "text" else []
+    return deliver("zpw", text, args.output, also)
 
 
 def _plot_cases(station: Station, args: argparse.Namespace) -> tuple[str, list[dict[int, str]]] | None:
