@@ -1,6 +1,8 @@
 """``liansuo zpw STATION [--fault SECTION:capacitor:N:open|half|short ...] [--format text|json|csv] [-o FILE]
 [--plot FILE] [--plot-csv FILE] [--section ID]``: the command line of :mod:`.zpwfigures` (the table) and
-:mod:`.zpwplot` (the profiles along one section)."""
+:mod:`.zpwplot` (the profiles along one section). ``liansuo zpw validate [--format text|json] [-o FILE]`` (the
+reserved word ``validate`` in place of STATION; a station file of that name is ``./validate``) puts the model beside
+the capacitor-fault article (:mod:`.zpwvalidate`)."""
 
 from __future__ import annotations
 
@@ -21,8 +23,12 @@ from liansuo.stations.station import Station
 
 from .zpwfigures import FAULT_FORM, FaultSpecError, as_text, collect_faults, section_rows, write_csv
 
+VALIDATE = "validate"
+
 
 def cmd_zpw(args: argparse.Namespace) -> int:
+    if args.station == VALIDATE:
+        return cmd_validate(args)
     if args.output and (why := unwritable(Path(args.output))):
         return refuse("zpw", why, Exit.USAGE)
     if why := plot_problem(args):
@@ -53,6 +59,28 @@ def cmd_zpw(args: argparse.Namespace) -> int:
         return refuse("zpw", why, Exit.USAGE)
     also = [f for f in (args.plot, args.plot_csv) if f] if args.format == "text" else []
     return deliver("zpw", text, args.output, also)
+
+
+def cmd_validate(args: argparse.Namespace) -> int:
+    """``liansuo zpw validate``: the article's rows beside the model's, always exit status 0 (a report, not a
+    check: docs/zpw2000a.md says why)."""
+    given = [opt for opt, value in (("--fault", args.fault), ("--plot", args.plot), ("--plot-csv", args.plot_csv),
+                                    ("--section", args.section)) if value]
+    if given or args.format == "csv":
+        what = given[0] if given else "--format csv"
+        return refuse("zpw", f"{what} does not go with 'validate', which takes only --format text|json and -o FILE",
+                      Exit.USAGE)
+    if args.output and (why := unwritable(Path(args.output))):
+        return refuse("zpw", why, Exit.USAGE)
+    from .zpwvalidate import as_text, summary, validate
+
+    rows = validate()
+    if args.format == "json":
+        text = json.dumps(report("zpw validate", True, {"rows": list(rows), "summary": summary(rows)}),
+                          ensure_ascii=False, indent=2) + "\n"
+    else:
+        text = as_text(rows) + "\n"
+    return deliver("zpw", text, args.output, [])
 
 
 def _plot_cases(station: Station, args: argparse.Namespace) -> tuple[str, list[dict[int, str]]] | None:
@@ -88,7 +116,8 @@ def check_warnings(station: Station) -> list[Diagnostic]:
 def register(add: Callable[[str, Callable[[argparse.Namespace], int], str], argparse.ArgumentParser]) -> None:
     """Add the ``zpw`` subcommand through the CLI's ``add(name, handler, help)``."""
     sp = add("zpw", cmd_zpw, "ZPW-2000A section figures: adjustment, shunt residual, cab current (with faults)")
-    sp.add_argument("station", help="bundled station name or path")
+    sp.add_argument("station", help="bundled station name or path; 'validate': the model against the capacitor-fault "
+                    "article (--format text|json, -o FILE)")
     sp.add_argument("--fault", action="append", default=[], metavar=FAULT_FORM,
                     help="a compensation-capacitor fault (repeatable); capacitors are numbered from the lower end")
     sp.add_argument("--format", choices=("text", "json", "csv"), default="text", help="text (default), json or csv")

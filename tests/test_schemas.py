@@ -76,9 +76,10 @@ def test_schema_of_an_unknown_kind_is_a_usage_error(capsys: pytest.CaptureFixtur
 def test_every_bundled_yaml_file_is_of_a_kind_with_a_schema() -> None:
     """A new folder of YAML files must be added to BUNDLED (and its files given a modeline); the rule sets have
     models of their own (rules/), not a schema for editors; so has the model data the code writes and reads (the
-    ZPW-2000A adjustment table, circuits/zpwadjust.py)."""
+    ZPW-2000A adjustment table, circuits/zpwadjust.py; the capacitor-fault article's tables,
+    circuits/zpwvalidate.py)."""
     skipped = {".venv", ".git", "build", "dist", "rules"}
-    model_data = {ROOT / "circuits" / "zpwadjust.yaml"}
+    model_data = {ROOT / "circuits" / "zpwadjust.yaml", ROOT / "circuits" / "zpwvalidate.yaml"}
     found = {p for p in ROOT.rglob("*.yaml") if not skipped & set(p.relative_to(ROOT).parts)} - model_data
     assert found == {path for path, _ in BUNDLED_FILES}
     assert {kind for _, kind in BUNDLED_FILES} == set(KINDS)
