@@ -171,7 +171,7 @@ class Core:
         return self.out
 
     def _lamp_alarms(self, signal: str) -> None:
-        """Flasher (SNJ/SNJJ) and red-lamp supervision of one signal whose proving relays changed."""
+        """Flasher (SNJ/SNJJ), filament, lamp and red-lamp supervision of one signal whose proving relays changed."""
         sig = self.station.signals[signal]
         if sig.usu:
             if self.board.flasher_ok(signal):
@@ -186,6 +186,9 @@ class Core:
                        "filament or dark")
         else:
             self.clear_alarm("filament", signal)
+        for key, alarm in list(self.alarms.items()):  # an aspect's lamps all proven again: its lamp alarm is over
+            if alarm.kind == "lamp" and alarm.element == signal and not self._dark(signal, alarm.detail):
+                del self.alarms[key]
         stop = stop_aspect(self.station, signal)  # the red (or blue) lamp is named as the stop aspect it shows
         if stop in [lamp.value for lamp in sig.lamps]:
             dark = not self.board.lamp_ok(signal, stop)
@@ -430,11 +433,18 @@ class Core:
         rid = self.by_signal.get(signal)
         return self.routes.get(rid) if rid else None
 
-    def proven(self, signal: str, aspect: str) -> str:
-        """The aspect after lamp proving: never more permissive than ``aspect``."""
+    def _dark(self, signal: str, aspect: str) -> set[str]:
+        """The lamps of ``aspect`` on ``signal`` not proven (and ``flasher`` for a flashing aspect whose flasher
+        failed): what keeps the aspect from showing."""
         dark = {lamp for lamp in self.rules.lamps.get(aspect, []) if not self.board.lamp_ok(signal, lamp)}
         if aspect in self.rules.aspects.flashing and not self.board.flasher_ok(signal):
             dark.add("flasher")
+        return dark
+
+    def proven(self, signal: str, aspect: str) -> str:
+        """The aspect after lamp proving: never more permissive than ``aspect``. A lamp alarm raised here ends when
+        the signal's lamp proving changes and the aspect's lamps are all proven again (:meth:`_lamp_alarms`)."""
+        dark = self._dark(signal, aspect)
         if not dark:
             return aspect
         shown = downgrade(aspect, dark, self.rules)

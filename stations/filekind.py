@@ -49,7 +49,7 @@ def kind_of_text(text: str) -> Kind | None:
         return None
     try:
         head = json.loads(first)
-    except ValueError:
+    except (ValueError, RecursionError):  # not JSON, or nested deeper than the parser goes: not a recording header
         return None
     return "recording" if isinstance(head, dict) and head.get("format") == RECORDING_FORMAT else None
 

@@ -10,7 +10,8 @@ import pytest
 from liansuo.cli.main import main
 from liansuo.simulation import Simulation
 from liansuo.simulation.exercise import bundled_exercises, check_goal, parse_exercise
-from liansuo.simulation.recording import FileRecorder, Recorder, RecordingError, Replayer, load_recording
+from liansuo.simulation.recording import FileRecorder, Recorder, RecordingError, load_recording
+from liansuo.simulation.replayer import Replayer
 from liansuo.stations.source import StationError
 
 
@@ -38,7 +39,11 @@ def test_the_recording_is_compact_json_lines_with_commands_and_changes(tmp_path:
     records = [json.loads(line) for line in path.read_text(encoding="utf-8").splitlines()]
     kinds = [r["k"] for r in records]
     assert kinds[0] == "header" and kinds[1] == "init" and kinds[-1] == "end"
+    head = records[0]
+    assert (head["version"], head["station"], head["station_id"]) == (2, "jiaopei", "jiaopei")
+    assert len(head["station_sha256"]) == 64
     cmds = [r for r in records if r["k"] == "cmd"]
+    assert [c["i"] for c in cmds] == list(range(1, 7)) and records[-1]["cmds"] == 6
     assert [(c["line"], c["by"], c["ok"]) for c in cmds] == [
         ("route X XI", "trainee", True), ("occupy IAG", "trainee", True), ("run 5s", "trainee", True),
         ("release X", "trainee", True), ("fault no-indication 5", "instructor", True),
@@ -83,14 +88,16 @@ def test_replay_verify_from_the_command_line(tmp_path: Path, capsys: pytest.Capt
     path = tmp_path / "s.jsonl"
     record_session(path)
     assert main(["replay", str(path), "--verify"]) == 0
-    assert "outputs reproduced" in capsys.readouterr().out
+    assert "6 commands: the start, every answer and every cycle reproduced" in capsys.readouterr().out
 
 
 def test_a_malformed_recording_names_its_line(tmp_path: Path) -> None:
     path = tmp_path / "bad.jsonl"
-    path.write_text('{"k":"header","format":"liansuo-recording","version":1,"station":"jiaopei","cycle_s":0.25}\n'
-                    "not json\n", encoding="utf-8")
-    with pytest.raises(RecordingError, match=":2: not a JSON record"):
+    record_session(path)
+    lines = path.read_text(encoding="utf-8").splitlines()
+    lines[2] = "not json"
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    with pytest.raises(RecordingError, match=r"bad.jsonl:3:2: error: not a JSON record: expected ident"):
         load_recording(path)
     path.write_text('{"k": "cmd"}\n', encoding="utf-8")
     with pytest.raises(RecordingError, match="not a liansuo recording"):

@@ -98,7 +98,7 @@ class ConsoleApp(App[None]):
         self.instructor_panel: InstructorPanel | None = None  # mounted the first time instructor mode opens
         self.recorder: FileRecorder | None = None
         if record is not None:
-            self.recorder = FileRecorder(self.sim, record, station=station)
+            self.recorder = FileRecorder(self.sim, record)
             self.recorder.attach()
 
     # ---- layout ----

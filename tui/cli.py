@@ -8,14 +8,18 @@ ends the command with its one-line message and exit status (docs/commands.md, "E
 from __future__ import annotations
 
 import argparse
-import sys
 from collections.abc import Callable
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from liansuo.stations.arguments import positive_number, unwritable
 from liansuo.stations.exitcodes import Exit, bad_input, refuse
+from liansuo.stations.printable import printable
 from liansuo.stations.source import StationError
 from liansuo.stations.station import Station
+
+if TYPE_CHECKING:
+    from liansuo.simulation.recordingfile import Recording
 
 Handler = Callable[[argparse.Namespace], int]
 Add = Callable[[str, Handler, str], argparse.ArgumentParser]
@@ -37,10 +41,13 @@ def register(add: Add) -> None:
 def register_replay(add: Add) -> None:
     sp = add("replay", cmd_replay, "play a recorded session back in the console, with seek and speed")
     sp.add_argument("file", help="a recording written by 'liansuo tui --record FILE'")
+    sp.add_argument("--station", metavar="STATION",
+                    help="replay on this station (a bundled name or a path) instead of the one the recording names, "
+                         "e.g. after the files moved; it must be the station the recording was made on")
     sp.add_argument("--speed", type=positive_number, default=1.0, metavar="X",
                     help="playback speed, greater than 0 (default 1)")
     sp.add_argument("--verify", action="store_true",
-                    help="no console: re-simulate the whole recording and check it reproduces the recorded outputs")
+                    help="no console: re-simulate the whole recording and check its start, answers and outputs")
     sp.add_argument("--format", choices=("text", "json"), default="text",
                     help="with --verify: text (default) or json")
 
@@ -81,35 +88,45 @@ def cmd_tui(args: argparse.Namespace) -> int:
 
 
 def cmd_replay(args: argparse.Namespace) -> int:
-    from liansuo.simulation.recording import RecordingError, Replayer, load_recording
+    from liansuo.simulation.recordingfile import RecordingError, load_recording, recording_station
 
     if args.format == "json" and not args.verify:
         return refuse("replay", "--format json goes with --verify (the console has no JSON)", Exit.USAGE)
     try:
         rec = load_recording(args.file)
+        station = recording_station(rec, args.station)
     except RecordingError as exc:
-        print(exc, file=sys.stderr)
-        return int(Exit.BAD_INPUT)
-    if isinstance(station := _load(rec.station), StationError):
-        return bad_input(station, f"station of {args.file}")
+        return bad_input(exc, "recording")
+    except StationError as exc:
+        return bad_input(exc, f"station of {printable(args.file)}")
     if args.verify:
-        bad = Replayer(rec).verify()
-        cmds = len(rec.commands)
-        if args.format == "json":
-            from liansuo.stations.jsonreport import print_report
-
-            print_report("replay", not bad, {"recording": rec.path, "station": rec.station, "cycles": rec.cycles,
-                                             "duration_s": round(rec.duration, 2), "commands": cmds,
-                                             "mismatches": bad})
-        else:
-            for line in bad:
-                print(line)
-            verdict = "outputs reproduced" if not bad else f"{len(bad)} mismatches"
-            print(f"{rec.cycles} cycles ({rec.duration:g} s), {cmds} commands: {verdict}")
-        if bad:
-            return refuse("replay", f"{len(bad)} of the recorded outputs not reproduced", Exit.FAILED)
-        return 0
+        return _verify(args, rec, station)
     from .replay import ReplayApp
 
-    ReplayApp(rec, speed=args.speed).run()
+    ReplayApp(rec, station, speed=args.speed).run()
+    return 0
+
+
+def _verify(args: argparse.Namespace, rec: Recording, station: Station) -> int:
+    """``replay --verify``: the whole recording re-simulated, every mismatch listed; 1 when there is one."""
+    from liansuo.simulation.replayer import Replayer
+
+    bad = Replayer(rec, station).verify()
+    cmds = len(rec.commands)
+    if args.format == "json":
+        from liansuo.stations.jsonreport import print_report
+
+        print_report("replay", not bad, {"recording": rec.path, "station": rec.station, "cycles": rec.cycles,
+                                         "duration_s": round(rec.duration, 2), "commands": cmds,
+                                         "mismatches": bad})
+    else:
+        from liansuo.stations.fit import fit, plural
+
+        for line in bad:
+            print(fit(printable(line)))
+        verdict = "the start, every answer and every cycle reproduced" if not bad else plural(len(bad), "mismatch",
+                                                                                               "mismatches")
+        print(fit(f"{plural(rec.cycles, 'cycle')} ({rec.duration:g} s), {plural(cmds, 'command')}: {verdict}"))
+    if bad:
+        return refuse("replay", f"{len(bad)} of the recorded answers and outputs not reproduced", Exit.FAILED)
     return 0

@@ -15,8 +15,11 @@ from rich.text import Text
 from textual.binding import Binding, BindingType
 
 from liansuo.simulation import Result
-from liansuo.simulation.recording import Recording, Replayer
+from liansuo.simulation.recordingfile import Recording
+from liansuo.simulation.replayer import Replayer
 from liansuo.simulation.timeparse import parse_duration
+from liansuo.stations.printable import printable
+from liansuo.stations.station import Station
 
 from .app import ConsoleApp
 from .layout import Ref
@@ -34,15 +37,17 @@ class ReplayApp(ConsoleApp):
         Binding("end", "seek_to(-1)", "end", show=False),
     ]
 
-    def __init__(self, rec: Recording, *, speed: float = 1.0, paused: bool = False) -> None:
-        self.replayer = Replayer(rec)
+    def __init__(self, rec: Recording, station: Station | None = None, *, speed: float = 1.0,
+                 paused: bool = False) -> None:
+        self.replayer = Replayer(rec, station)
         self.rec = rec
         super().__init__(rec.station, paused=paused, speed=speed, sim=self.replayer.sim)
         self.warm_up = False  # the recording has its own first cycle
 
     def started(self) -> None:
         log = self.log_panel
-        log.add(f"replay of {self.rec.path}: {self.rec.duration:g} s, {len(self.rec.commands)} commands", "bold")
+        log.add(f"replay of {printable(self.rec.path)}: {self.rec.duration:g} s, {len(self.rec.commands)} commands",
+                "bold")
         self.say("replay: space play/pause, [ ] seek 10 s, { } 60 s, Home/End, > < speed, ': seek 2min'")
 
     def advance(self, cycles: int) -> None:
@@ -50,16 +55,17 @@ class ReplayApp(ConsoleApp):
         before = len(self.replayer.played)
         self.replayer.advance(target)
         self._log_played(before)
-        if self.replayer.cycle >= self.rec.cycles:
+        if self.replayer.done:
             self.paused = True
 
     def _log_played(self, before: int) -> None:
         log = self.log_panel
-        for r in self.replayer.played[before:]:
-            who = f"{r.get('by', '')}>"
-            log.add(f"{float(r['t']):9.2f} {who:8} {r['line']}", "#9fd3ff")
-            if not r.get("ok"):
-                log.add(f"{float(r['t']):9.2f} {'refused':8} {r.get('msg', '')}", "#ff8080")
+        for played in self.replayer.played[before:]:
+            cmd = played.cmd
+            who = f"{printable(cmd.by)}>"
+            log.add(f"{cmd.t:9.2f} {who:8} {printable(cmd.line)}", "#9fd3ff")
+            if not cmd.ok:
+                log.add(f"{cmd.t:9.2f} {'refused':8} {printable(cmd.msg)}", "#ff8080")
 
     def seek(self, t: float) -> None:
         try:
