@@ -14,7 +14,7 @@ from functools import partial
 
 from liansuo.bench import cli as bench
 from liansuo.circuits import phase25cli, zpwcli
-from liansuo.cli import completion, schemas
+from liansuo.cli import completion, fuzz, schemas
 from liansuo.interlocking import cli as interlocking
 from liansuo.proving import cli as proving
 from liansuo.proving import mutation, soakcli
@@ -38,6 +38,7 @@ REGISTER: tuple[Callable[[Add], None], ...] = (
     verify.register,  # verify
     soakcli.register,  # soak
     mutation.register,  # mutate
+    fuzz.register,  # fuzz
     bench.register,  # bench
     tui.register,  # tui
     tui.register_replay,  # replay
