@@ -24,7 +24,7 @@ from typing import IO, Any
 
 from liansuo.interlocking.io import Result
 from liansuo.stations.filekind import RECORDING_FORMAT, kind_of_data, kind_of_text, wrong_kind
-from liansuo.stations.source import StationError, read_yaml
+from liansuo.stations.source import StationError, read_text, read_yaml
 
 from .sim import Simulation
 
@@ -192,12 +192,11 @@ def load_recording(path: str | Path) -> Recording:
     """Read a recording; :class:`RecordingError` names the line of anything malformed, and the kind of a file that
     is another kind of liansuo file (a station, a script ...)."""
     p = Path(path)
-    try:
-        whole = p.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise RecordingError(f"{p}:1: no such file; give a recording written by 'liansuo tui --record FILE'") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise RecordingError(f"{p}:1: cannot read the file: {exc}") from exc
+    try:  # within the input limits: a device, a pipe or a file too large is refused, never read
+        whole = read_text(p, "give a recording written by 'liansuo tui --record FILE'")
+    except StationError as exc:
+        d = exc.diagnostics[0]
+        raise RecordingError(f"{d.file}:{d.line}: {d.message}") from None
     if kind_of_text(whole) != "recording":
         try:
             found = kind_of_data(read_yaml(whole, str(p)).data)
