@@ -31,6 +31,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import yaml
 
+from liansuo.rules.safeyaml import build, compose, read_file
+
 from .zpw2000a import (
     BASE_CARRIERS,
     DEFAULT_PARAMS,
@@ -114,7 +116,8 @@ def _settings(data: dict[str, Any]) -> dict[str, Any]:
 
 def load_table(path: Path = TABLE_FILE) -> AdjustmentTable:
     """The table as stored (``zpwadjust.yaml`` by default)."""
-    data = yaml.safe_load(path.read_text(encoding="utf-8"))
+    root = compose(read_file(path))
+    data: dict[str, Any] = build(root).data if root is not None else {}
     rows = tuple(Row(str(r["carrier"]), float(r["cable_km"]), float(r["from_m"]), float(r["to_m"]), int(r["level"]),
                      float(r["adjust_mV"]), bool(r["adjustable"])) for r in data["rows"])
     return AdjustmentTable(**_settings(data), rows=rows)

@@ -19,6 +19,7 @@ from collections.abc import Iterator
 from typing import TextIO
 
 from liansuo.stations.jsonreport import envelope
+from liansuo.stations.printable import printable_block
 
 from .signedtable import COLUMNS, SignedTable, cell_width, signed_table
 from .table import InterlockingTable
@@ -78,7 +79,7 @@ def render_text(signed: SignedTable, table: InterlockingTable) -> str:
     if table.unselectable:
         lines += wrap("无变通按钮, 不能排列的径路: " + "; ".join(table.unselectable), WIDTH)
     lines.append(f"{len(table.routes)} 条进路 routes")
-    return "\n".join(lines)
+    return printable_block("\n".join(lines))  # a note from the station file ('why:') may hold control characters
 
 
 def as_text(table: InterlockingTable) -> str:

@@ -11,6 +11,8 @@ from openpyxl import Workbook
 from openpyxl.styles import Alignment, Border, Font, Side
 from openpyxl.utils import get_column_letter
 
+from liansuo.stations.printable import printable
+
 from .signedtable import COLUMNS, SignedTable
 
 SIGN_OFF = ("编制 Compiled", "复核 Checked", "批准 Approved", "日期 Date")
@@ -50,7 +52,7 @@ def write_xlsx(signed: SignedTable, path: Path) -> None:
         for cell in ws[2]:
             cell.font, cell.border = Font(bold=True), _BOX
         for row in g.rows:
-            ws.append([row.cells[c.key] for c in COLUMNS])
+            ws.append([printable(row.cells[c.key]) for c in COLUMNS])  # a cell may quote the station file
             for cell in ws[ws.max_row]:
                 cell.alignment, cell.border = Alignment(wrap_text=True, vertical="top"), _BOX
         for i, c in enumerate(COLUMNS, 1):

@@ -39,13 +39,13 @@ def pytest_addoption(parser: pytest.Parser) -> None:
 
 
 def is_script(path: Path) -> bool:
-    """A YAML mapping with ``station:`` and a ``tests:`` list (read cheaply; errors mean 'not a script')."""
-    import yaml
+    """A YAML mapping with ``station:`` and a ``tests:`` list (read within the input limits, as every liansuo file
+    is; errors mean 'not a script')."""
+    from liansuo.stations.source import StationError, read_text, read_yaml
 
     try:
-        with path.open(encoding="utf-8") as fh:
-            data = yaml.safe_load(fh)
-    except (OSError, yaml.YAMLError, UnicodeDecodeError):
+        data = read_yaml(read_text(path), str(path)).data
+    except StationError:
         return False
     return isinstance(data, dict) and "station" in data and isinstance(data.get("tests"), list)
 
@@ -73,11 +73,11 @@ class ScriptFile(pytest.File):
         from liansuo.interlocking.table import build_table
         from liansuo.stations.source import StationError
 
-        from .scripts import _resolve_station, parse_script
+        from .scripts import parse_script, script_station
 
         try:
             script = parse_script(self.path)
-            station = _resolve_station(script, self.path.parent)
+            station = script_station(script)
             table = build_table(station)
         except StationError as exc:
             raise ScriptError("\n".join(str(d) for d in exc.diagnostics)) from None

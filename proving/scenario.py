@@ -22,7 +22,9 @@ from typing import Any
 
 from liansuo.simulation.sim import LANGUAGE, Simulation
 from liansuo.stations.filekind import read_source
+from liansuo.stations.library import resolve_from
 from liansuo.stations.loader import load
+from liansuo.stations.printable import printable
 from liansuo.stations.source import Diagnostic, StationError
 from liansuo.stations.station import Station
 from liansuo.stations.validation import validate
@@ -66,14 +68,9 @@ class ScenarioLog:
 
 
 def station_of(sc: Scenario) -> Station:
-    """The scenario's station: a bundled name, or a path as given or relative to the scenario's folder."""
-    try:
-        return load(sc.station)
-    except StationError:
-        candidate = Path(sc.file).parent / sc.station
-        if candidate.exists():
-            return load(candidate)
-        raise
+    """The scenario's station: a bundled name, or a path relative to the scenario's folder (from wherever the
+    scenario is run); :class:`StationError` when it does not load."""
+    return load(resolve_from(sc.station, sc.file))
 
 
 def run_scenario(sc: Scenario, until_s: float | None = None, out: list[str] | None = None,
@@ -92,7 +89,7 @@ def run_scenario(sc: Scenario, until_s: float | None = None, out: list[str] | No
 
     def emit(text: str) -> None:
         if out is None:
-            print(text)
+            print(printable(text))  # an event may quote a step of the file
         else:
             out.append(text)
 

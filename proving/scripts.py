@@ -26,6 +26,7 @@ from pathlib import Path
 from liansuo.interlocking.io import Result
 from liansuo.simulation.sim import LANGUAGE, Simulation
 from liansuo.stations.filekind import read_source
+from liansuo.stations.library import resolve_from
 from liansuo.stations.loader import load
 from liansuo.stations.source import Diagnostic, StationError
 from liansuo.stations.station import Station
@@ -108,20 +109,10 @@ def parse_script(path: Path) -> Script:
     return Script(str(path), model.station, tests, model.cycle_ms / 1000.0, model.safety)
 
 
-def _resolve_station(script: Script, src_dir: Path) -> Station:
-    try:
-        return load(script.station)
-    except StationError:
-        candidate = src_dir / script.station
-        if candidate.exists():
-            return load(candidate)
-        raise
-
-
 def script_station(script: Script) -> Station:
-    """The station the script runs on: a bundled name, or a path as given or relative to the script's folder;
-    :class:`StationError` when it does not load."""
-    return _resolve_station(script, Path(script.file).parent)
+    """The station the script runs on: a bundled name, or a path relative to the script's folder (from wherever the
+    script is run); :class:`StationError` when it does not load."""
+    return load(resolve_from(script.station, script.file))
 
 
 def selected(script: Script, only: str | None) -> list[ScriptTest]:

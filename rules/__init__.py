@@ -8,8 +8,9 @@
 - ``driving.yaml``: ``rules.driving``; ``design.yaml``: ``rules.design``; ``equipment.yaml``: ``rules.equipment``.
 
 This is the bottom layer: it imports none of the others, so every layer may read it (docs/rules.md). It holds rule
-data and its validation only, never rule code: the Chinese aspect selection lives in ``interlocking/aspects.py``,
-and the safety oracle, which may read this package, shares none of that code.
+data and its validation only, and the one YAML reader that reads them and every other liansuo file within the input
+limits (:mod:`.safeyaml`, :mod:`.inputlimits`), never rule code: the Chinese aspect selection lives in
+``interlocking/aspects.py``, and the safety oracle, which may read this package, shares none of that code.
 """
 
 from __future__ import annotations

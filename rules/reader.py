@@ -1,6 +1,6 @@
 """Reading a rule file while remembering where each value stands, so that bad rule data is reported as
-``FILE:LINE:COLUMN: error: message``, the way station files are (``stations/source.py``; this layer is below
-``stations`` and cannot borrow its reader)."""
+``FILE:LINE:COLUMN: error: message``, the way station files are: both are read by :mod:`.safeyaml`, within the
+same limits."""
 
 from __future__ import annotations
 
@@ -9,13 +9,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, TypeVar
 
-import yaml
 from pydantic import BaseModel, ValidationError
 
-Loc = tuple[str | int, ...]
-M = TypeVar("M", bound=BaseModel)
+from .safeyaml import Loc, Mark, YamlProblem, build, compose, read_file
 
-_scalars = yaml.SafeLoader(stream="")
+M = TypeVar("M", bound=BaseModel)
+__all__ = ["Loc", "Problem", "RuleError", "RuleFile", "read", "validate"]
 
 
 @dataclass(frozen=True)
@@ -45,58 +44,33 @@ class RuleFile:
 
     file: str
     data: Any = None
-    marks: dict[Loc, tuple[int, int]] = field(default_factory=dict)
+    marks: dict[Loc, Mark] = field(default_factory=dict)
 
     def problem(self, loc: Loc, message: str) -> Problem:
         """A problem at ``loc``, placed at the nearest enclosing value the file has."""
         loc = tuple(loc)
         while loc and loc not in self.marks:
             loc = loc[:-1]
-        line, column = self.marks.get(loc, (1, 1))
-        return Problem(self.file, line, column, message)
-
-
-def _build(node: yaml.Node, loc: Loc, rf: RuleFile, problems: list[Problem]) -> Any:
-    rf.marks[loc] = (node.start_mark.line + 1, node.start_mark.column + 1)
-    if isinstance(node, yaml.MappingNode):
-        out: dict[str, Any] = {}
-        for key_node, value_node in node.value:
-            # keys as written: an aspect or lamp named Y or N stays a name, not a YAML 1.1 boolean
-            key = str(key_node.value) if isinstance(key_node, yaml.ScalarNode) else None
-            where = (key_node.start_mark.line + 1, key_node.start_mark.column + 1)
-            if key is None or key in out:
-                problems.append(Problem(rf.file, *where, "a key must be a plain name" if key is None
-                                        else f"key '{key}' appears twice in the same mapping"))
-                continue
-            out[key] = _build(value_node, (*loc, key), rf, problems)
-        return out
-    if isinstance(node, yaml.SequenceNode):
-        return [_build(item, (*loc, i), rf, problems) for i, item in enumerate(node.value)]
-    return _scalars.construct_object(node, deep=True)
+        mark = self.marks.get(loc, Mark(1, 1))
+        return Problem(self.file, mark.line, mark.column, message)
 
 
 def read(path: Path) -> RuleFile:
     """Parse one rule file; raise :class:`RuleError` if it is missing or is not readable YAML."""
     rf = RuleFile(str(path))
     try:
-        root = yaml.compose(path.read_text(encoding="utf-8"), Loader=yaml.SafeLoader)
-    except FileNotFoundError:
-        raise RuleError([Problem(rf.file, 1, 1, "no such file: every rule set has this file (see docs/rules.md)")]
-                        ) from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise RuleError([Problem(rf.file, 1, 1, f"cannot read the file: {exc}")]) from None
-    except yaml.MarkedYAMLError as exc:
-        mark = exc.problem_mark or exc.context_mark
-        line, col = (mark.line + 1, mark.column + 1) if mark else (1, 1)
-        raise RuleError([Problem(rf.file, line, col, f"YAML syntax error: {exc.problem or exc.context}")]) from None
-    except yaml.YAMLError as exc:
-        raise RuleError([Problem(rf.file, 1, 1, f"YAML error: {exc}")]) from None
-    if not isinstance(root, yaml.MappingNode):
+        root = compose(read_file(path))
+    except YamlProblem as exc:
+        message = ("no such file: every rule set has this file (see docs/rules.md)" if exc.what == "missing"
+                   else exc.message)
+        raise RuleError([Problem(rf.file, exc.line, exc.column, message)]) from None
+    if root is None or root.tag != "tag:yaml.org,2002:map":
         raise RuleError([Problem(rf.file, 1, 1, "a rule file is a mapping of 'key: value' lines")])
-    problems: list[Problem] = []
-    rf.data = _build(root, (), rf, problems)
-    if problems:
-        raise RuleError(problems)
+    # keys as written: an aspect or lamp named Y or N stays a name, not a YAML 1.1 boolean
+    tree = build(root, keys_as_written=True)
+    if tree.problems:
+        raise RuleError([Problem(rf.file, p.line, p.column, p.message) for p in tree.problems])
+    rf.data, rf.marks = tree.data, tree.marks
     return rf
 
 

@@ -22,7 +22,7 @@ from importlib.resources import files
 from pathlib import Path
 
 from liansuo.stations.filekind import read_source
-from liansuo.stations.library import bundled
+from liansuo.stations.library import bundled, resolve_from
 from liansuo.stations.source import Diagnostic, StationError
 from liansuo.stations.validation import validate
 
@@ -44,7 +44,7 @@ class Exercise:
         """The station as a bundled name, or a path resolved against the exercise file."""
         if self.station in bundled():
             return self.station
-        return str((Path(self.file).parent / self.station).resolve())
+        return str(resolve_from(self.station, self.file).resolve())
 
 
 @dataclass
@@ -71,7 +71,7 @@ def parse_exercise(path: str | Path) -> Exercise:
         raise StationError(errors)
     goal = model.goal or Goal()
     expect = [line if line.strip().startswith("expect") else f"expect {line.strip()}" for line in goal.expect]
-    return Exercise(str(path), model.title, model.station, str(model.description).strip(), setup,
+    return Exercise(str(given), model.title, model.station, str(model.description).strip(), setup,
                     str(goal.description).strip(), expect)
 
 

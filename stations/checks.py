@@ -500,6 +500,10 @@ class _Checker:
                 self.err(("links", k, "kind"), f"station-to-station block line {lk.id} names no sections",
                          "list the line's sections under 'sections:' (those the axle counters prove clear), "
                          "nearest the station first")
+            if lk.kind is LinkKind.semi_auto_64d and not lk.sections:
+                self.err(("links", k, "kind"), f"64D semi-automatic block line {lk.id} names no sections: its block "
+                         "machine sees our train depart by its departure section",
+                         "name the departure section (the first a departing train occupies) under 'sections:'")
             roles = {roles_of[sec] for sec in lk.sections if sec in roles_of}
             if lk.kind is LinkKind.automatic and roles >= {SectionRole.approach, SectionRole.departure}:
                 self.err(("links", k, "sections"), f"link {lk.id} mixes approach and departure sections, so its "

@@ -8,6 +8,7 @@ from __future__ import annotations
 import sys
 from enum import IntEnum
 
+from .printable import printable
 from .source import StationError
 
 
@@ -22,8 +23,9 @@ class Exit(IntEnum):
 
 
 def refuse(command: str, message: str, status: Exit) -> int:
-    """Print ``liansuo COMMAND: MESSAGE`` on stderr, one line, and give ``status`` back for the command to return."""
-    print(f"liansuo {command}: {message}", file=sys.stderr)
+    """Print ``liansuo COMMAND: MESSAGE`` on stderr, one line (control characters a message may quote from a file
+    written out), and give ``status`` back for the command to return."""
+    print(f"liansuo {command}: {printable(message)}", file=sys.stderr)
     return int(status)
 
 

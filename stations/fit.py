@@ -2,12 +2,15 @@
 
 A long line is folded at spaces and its continuation lines are indented, so a reader sees where an item goes on; a
 word longer than the width (a long file path) is never cut. Chinese characters count as two columns, as a terminal
-shows them.
+shows them. Control characters are written out (:func:`~.printable.printable`): a line may quote a file, and the
+terminal must only receive what liansuo means to draw.
 """
 
 from __future__ import annotations
 
 import unicodedata
+
+from .printable import printable_block
 
 WIDTH = 100
 
@@ -20,6 +23,7 @@ def columns(text: str) -> int:
 def fit(line: str, indent: str = "    ", width: int = WIDTH, keep: int = 1) -> str:
     """``line`` folded to ``width`` columns, continuation lines starting with ``indent`` after the line's own
     leading spaces; its first ``keep`` words stay on its first line (a diagnostic's 'FILE:LINE:COL: error: what')."""
+    line = printable_block(line)
     if columns(line) <= width:
         return line
     lead = line[:len(line) - len(line.lstrip(" "))]

@@ -5,7 +5,9 @@ from __future__ import annotations
 from importlib.resources import files
 from pathlib import Path
 
-import yaml
+from liansuo.rules.safeyaml import YamlProblem, build, compose, read_file
+
+from .printable import printable
 
 LIBRARY = Path(str(files("liansuo.stations") / "library"))  # package data, installed with liansuo
 DEFAULT_STATION = "jiaopei"
@@ -25,17 +27,29 @@ def resolve(name_or_path: str | Path) -> Path:
     return Path(text)
 
 
+def resolve_from(name_or_path: str, named_in: str | Path) -> Path:
+    """The station that the file ``named_in`` (a script, a scenario, an exercise) names with ``station:``: a
+    bundled name, or a path, a relative one taken from the folder of ``named_in`` (docs/commands.md), never from the
+    current folder, so a file means the same station from wherever it is run."""
+    found = bundled().get(name_or_path)
+    if found is not None:
+        return found
+    return Path(named_in).parent / Path(name_or_path)  # an absolute path stays as it is
+
+
 def describe(path: Path) -> str:
-    """The one-line description of a bundled station, read without validating the whole file."""
+    """The one-line description of a bundled station, read without validating the whole file, control characters
+    written out."""
     try:
-        data = yaml.safe_load(path.read_text(encoding="utf-8"))
-    except (OSError, yaml.YAMLError):
+        root = compose(read_file(path))
+    except YamlProblem:
         return "(unreadable)"
+    data = build(root).data if root is not None else None
     if not isinstance(data, dict):
         return ""
     name = data.get("name") or {}
     desc = str(data.get("description", "")).strip().splitlines()
     first = desc[0] if desc else ""
     if isinstance(name, dict):
-        return f"{name.get('zh', '')} {name.get('en', '')}: {first}".strip()
-    return first
+        return printable(f"{name.get('zh', '')} {name.get('en', '')}: {first}".strip())
+    return printable(first)

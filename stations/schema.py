@@ -13,6 +13,8 @@ from typing import Annotated, Literal
 
 from pydantic import AfterValidator, BaseModel, BeforeValidator, ConfigDict, Field, WithJsonSchema
 
+from liansuo.rules.inputlimits import LIMITS
+
 _ID_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_\-/]*$")
 _KM_RE = re.compile(r"^K(\d+)\+(\d+(?:\.\d+)?)$")
 
@@ -25,21 +27,29 @@ def _to_id(value: object) -> object:
     return value
 
 
+def _check_length(value: str, what: str) -> None:
+    if len(value) > LIMITS.max_id_chars:
+        raise ValueError(f"{what} of {len(value):,} characters: an id has at most {LIMITS.max_id_chars}, as "
+                         "written on the station diagram")
+
+
 def _check_id(value: str) -> str:
-    if not _ID_RE.match(value):
+    _check_length(value, "an id")
+    if not _ID_RE.fullmatch(value):  # fullmatch: '$' alone would let a line break end an id
         raise ValueError(f"'{value}' is not a valid id: use letters, digits, '-', '_' or '/', starting with a "
                          "letter or digit")
     return value
 
 
 # JSON Schema: what the loader accepts (a whole number such as turnout 1 is taken as the id '1').
-_ID_SCHEMA = {"anyOf": [{"type": "string", "pattern": _ID_RE.pattern}, {"type": "integer", "minimum": 0}]}
+_ID_SCHEMA = {"anyOf": [{"type": "string", "pattern": _ID_RE.pattern, "maxLength": LIMITS.max_id_chars},
+                        {"type": "integer", "minimum": 0}]}
 Id = Annotated[str, BeforeValidator(_to_id), AfterValidator(_check_id), WithJsonSchema(_ID_SCHEMA)]
 
 
 def parse_km(text: str) -> float:
     """``K12+345.6`` -> 12345.6 metres."""
-    m = _KM_RE.match(text.strip())
+    m = _KM_RE.fullmatch(text.strip())
     if not m:
         raise ValueError(f"'{text}' is not a position: write metres (e.g. 350.5) or a kilometre post (K12+345.6)")
     return int(m.group(1)) * 1000 + float(m.group(2))
@@ -194,7 +204,7 @@ _CARRIER_RE = re.compile(r"^(1700|2000|2300|2600)-(1|2)$")
 
 
 def _check_carrier(value: str) -> str:
-    if not _CARRIER_RE.match(value):
+    if not _CARRIER_RE.fullmatch(value):
         raise ValueError(f"'{value}' is not a ZPW-2000A carrier: use 1700, 2000, 2300 or 2600 with -1 or -2, "
                          "e.g. '2300-1'")
     return value
@@ -235,6 +245,18 @@ class Lamp(StrEnum):
     L2 = "L2"  # second green (LL)
 
 
+def _each_lamp_once(lamps: list[Lamp]) -> list[Lamp]:
+    twice = next((lamp for i, lamp in enumerate(lamps) if lamp in lamps[:i]), None)
+    if twice is not None:
+        raise ValueError(f"lamp {twice.value} is listed twice: a signal has each lamp once")
+    return lamps
+
+
+# A signal's lamps, each once (the lamp circuits have one filament pair per lamp).
+Lamps = Annotated[list[Lamp], Field(min_length=1, json_schema_extra={"uniqueItems": True}),
+                  AfterValidator(_each_lamp_once)]
+
+
 class Button(StrEnum):
     train = "train"  # 列车按钮 LA
     shunt = "shunt"  # 调车按钮 DA
@@ -247,7 +269,7 @@ class Signal(Strict):
     kind: SignalKind
     at: Id
     direction: Direction
-    lamps: list[Lamp] = Field(min_length=1)
+    lamps: Lamps
     usu: bool = False  # may show the flashing yellow USU (needs a U and a U2 lamp)
     flasher: Literal["relay", "electronic"] = "electronic"  # USU flasher: classic RC relay (SNJ/SNJJ) or electronic
     buttons: list[Button] = Field(default_factory=list)
@@ -384,7 +406,8 @@ _ROUTE_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_\-/]*(\([A-Za-z0-9_\-/,]+\))?(\+
 
 
 def _check_route_id(value: str) -> str:
-    if not _ROUTE_RE.match(value):
+    _check_length(value, "a route id")
+    if not _ROUTE_RE.fullmatch(value):
         raise ValueError(f"'{value}' is not a route id: routes are named START-END, with the variant buttons in "
                          "brackets (X-XI(BA1)); see 'liansuo table STATION'")
     return value
@@ -393,7 +416,8 @@ def _check_route_id(value: str) -> str:
 # A route of the interlocking table, as 'liansuo table' names it: START-END, START-END(VIA), START-END/D, and
 # START-END+OVERLAP_END for a route with an alternative overlap.
 RouteId = Annotated[str, AfterValidator(_check_route_id), WithJsonSchema({"type": "string",
-                                                                           "pattern": _ROUTE_RE.pattern})]
+                                                                           "pattern": _ROUTE_RE.pattern,
+                                                                           "maxLength": LIMITS.max_id_chars})]
 
 
 class ProtectionOverride(Strict):

@@ -7,24 +7,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-import yaml
+from liansuo.rules.safeyaml import Loc, Mark, YamlProblem, build, compose, read_file
 
 from .fit import fit
+from .printable import printable
 
-try:  # the C loader is much faster where libyaml is present
-    from yaml import CSafeLoader as _Loader
-except ImportError:  # pragma: no cover - depends on how PyYAML was built
-    from yaml import SafeLoader as _Loader  # type: ignore[assignment]
-
-Loc = tuple[str | int, ...]
-
-
-@dataclass(frozen=True)
-class Mark:
-    """A 1-based line and column in a source file."""
-
-    line: int
-    column: int
+__all__ = ["Diagnostic", "Loc", "Mark", "Source", "StationError", "read_text", "read_yaml"]
 
 
 @dataclass(frozen=True)
@@ -41,8 +29,8 @@ class Diagnostic:
     def __str__(self) -> str:
         """One line, as compilers write it (``FILE:LINE:COLUMN: error: ...``), for stderr and the tools that read
         it; the hint on a line of its own."""
-        text = f"{self.file}:{self.line}:{self.column}: {self.severity}: {self.message}"
-        return text + (f"\n    hint: {self.hint}" if self.hint else "")
+        text = f"{printable(self.file)}:{self.line}:{self.column}: {self.severity}: {printable(self.message)}"
+        return text + (f"\n    hint: {printable(self.hint)}" if self.hint else "")
 
     def text(self, lead: str = "") -> str:
         """The diagnostic in a report on stdout (``liansuo check``): each line starting with ``lead``, folded to
@@ -98,82 +86,33 @@ class Source:
         return Diagnostic(self.file, m.line, m.column, message, hint, severity)
 
 
-_scalar_constructor = yaml.SafeLoader(stream="")
-
-
-def _build(node: yaml.Node, loc: Loc, src: Source, errors: list[Diagnostic]) -> Any:
-    src.marks[loc] = Mark(node.start_mark.line + 1, node.start_mark.column + 1)
-    if isinstance(node, yaml.MappingNode):
-        result: dict[Any, Any] = {}
-        for key_node, value_node in node.value:
-            key = _build(key_node, (*loc, "__key__"), src, errors)
-            src.marks.pop((*loc, "__key__"), None)
-            if not isinstance(key, str | int):
-                errors.append(Diagnostic(src.file, key_node.start_mark.line + 1,
-                                         key_node.start_mark.column + 1,
-                                         f"a key must be a name, not {type(key).__name__}",
-                                         "write keys as plain words such as 'id:'"))
-                continue
-            if isinstance(key, bool | int):  # as the JSON the schema sees ('true', '12'), so marks match its locs
-                key = str(key).lower() if isinstance(key, bool) else str(key)
-            if key in result:
-                errors.append(Diagnostic(src.file, key_node.start_mark.line + 1,
-                                         key_node.start_mark.column + 1,
-                                         f"key '{key}' appears twice in the same mapping",
-                                         "remove or rename one of them"))
-                continue
-            src.key_marks[(*loc, key)] = Mark(key_node.start_mark.line + 1, key_node.start_mark.column + 1)
-            result[key] = _build(value_node, (*loc, key), src, errors)
-        return result
-    if isinstance(node, yaml.SequenceNode):
-        return [_build(item, (*loc, i), src, errors) for i, item in enumerate(node.value)]
-    return _scalar_constructor.construct_object(node, deep=True)
+def _diagnostic(file: str, problem: YamlProblem) -> Diagnostic:
+    return Diagnostic(file, problem.line, problem.column, problem.message, problem.hint)
 
 
 def read_yaml(text: str, file: str) -> Source:
-    """Parse ``text``; raise :class:`StationError` with the position of any syntax error."""
-    src = Source(file=file, data=None)
+    """Parse ``text`` within the input limits (:mod:`liansuo.rules.safeyaml`); raise :class:`StationError` with the
+    place of anything that cannot be read: a syntax error, a control character, an alias that repeats too much ..."""
     try:
-        root = yaml.compose(text, Loader=_Loader)
-    except yaml.MarkedYAMLError as exc:
-        mark = exc.problem_mark or exc.context_mark
-        line, col = (mark.line + 1, mark.column + 1) if mark else (1, 1)
-        problem = exc.problem or exc.context or "invalid YAML"
-        cm = exc.context_mark
-        if exc.problem and exc.context and cm is not None and mark is not None and cm.line != mark.line:
-            problem += f" ({exc.context} at line {cm.line + 1}, column {cm.column + 1})"
-        bad_line = text.split("\n")[mark.line] if mark is not None and mark.line <= text.count("\n") else ""
-        if mark is not None and bad_line[mark.column:mark.column + 1] == "\t":
-            problem += " (a tab: indent YAML with spaces)"
-        raise StationError([Diagnostic(file, line, col, f"YAML syntax error: {problem}",
-                                       "check indentation, colons and quotes around this line")]) from None
-    except yaml.YAMLError as exc:
-        raise StationError([Diagnostic(file, 1, 1, f"YAML error: {exc}", "")]) from None
-    except ValueError as exc:  # e.g. characters PyYAML refuses
-        raise StationError([Diagnostic(file, 1, 1, f"cannot read the file as YAML: {exc}", "")]) from None
+        root = compose(text)
+    except YamlProblem as exc:
+        raise StationError([_diagnostic(file, exc)]) from None
     if root is None:
         raise StationError([Diagnostic(file, 1, 1, "the file is empty",
                                        "a station file starts with 'id:', 'name:' and 'tracks:'")])
-    errors: list[Diagnostic] = []
-    try:
-        src.data = _build(root, (), src, errors)
-    except (yaml.YAMLError, ValueError, TypeError, RecursionError) as exc:
-        raise StationError([Diagnostic(file, 1, 1, f"cannot read a value: {exc}", "")]) from None
-    if errors:
-        raise StationError(errors)
-    return src
+    tree = build(root)
+    if tree.problems:
+        raise StationError([_diagnostic(file, p) for p in tree.problems])
+    return Source(file, tree.data, tree.marks, tree.key_marks)
 
 
 def read_text(path: Path, missing_hint: str = "give a bundled station name (see 'liansuo stations') or a path"
               ) -> str:
-    """The file's text; :class:`StationError` at ``FILE:1:1`` when it is missing or unreadable."""
+    """The file's text, read within the input limits; :class:`StationError` at ``FILE:LINE:COLUMN`` when it is
+    missing, a folder, a device or a pipe, too large, unreadable or not UTF-8."""
     try:
-        return path.read_text(encoding="utf-8")
-    except (FileNotFoundError, NotADirectoryError):
-        raise StationError([Diagnostic(str(path), 1, 1, f"no such file; {missing_hint}")]) from None
-    except IsADirectoryError:
-        raise StationError([Diagnostic(str(path), 1, 1, f"this is a folder, not a file; {missing_hint}")]) from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise StationError([Diagnostic(str(path), 1, 1, f"cannot read the file: {exc}",
-                                       "liansuo's files are UTF-8 text")]) from None
-
+        return read_file(path)
+    except YamlProblem as exc:
+        if exc.what:  # a path that names no file: say how to name one
+            exc = YamlProblem(exc.line, exc.column, f"{exc.message}; {missing_hint}")
+        raise StationError([_diagnostic(str(path), exc)]) from None

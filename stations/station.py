@@ -6,6 +6,7 @@ from dataclasses import dataclass
 from functools import cached_property
 from typing import TYPE_CHECKING
 
+from .printable import printable
 from .schema import (
     Direction,
     End,
@@ -285,7 +286,8 @@ class Station:
         return self.sections[section].role is SectionRole.station_track
 
     def display_name(self) -> str:
-        return f"{self.model.name.zh} ({self.model.name.en})"
+        """The name for a heading, control characters written out (:func:`~.printable.printable`)."""
+        return printable(f"{self.model.name.zh} ({self.model.name.en})")
 
     @cached_property
     def topology(self) -> Topology:
