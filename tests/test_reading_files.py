@@ -73,8 +73,10 @@ def test_the_alias_bomb_is_refused_through_a_script_or_a_scenario_too(
 def test_the_alias_bomb_is_refused_through_a_recording_header(
         tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     bomb = written(tmp_path, BOMB + MINIMAL, "bomb.yaml")
-    header = json.dumps({"k": "header", "format": "liansuo-recording", "version": 1, "station": str(bomb),
-                         "cycle_s": 0.25}) + "\n"
+    records = [{"k": "header", "format": "liansuo-recording", "version": 2, "station": str(bomb),
+                "station_id": "minimal", "station_sha256": "", "cycle_s": 0.25, "t0": 0.0},
+               {"k": "init", "n": 0, "t": 0.0, "in": {}, "out": {}}, {"k": "end", "n": 0, "t": 0.0, "cmds": 0}]
+    header = "".join(json.dumps(r) + "\n" for r in records)
     code, _, err = run(capsys, "replay", str(written(tmp_path, header, "rec.jsonl")), "--verify")
     assert code == 3 and err.startswith(f"{bomb}:5:47: error: the alias '*l3' repeats 11,111 values")
 
