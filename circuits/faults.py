@@ -10,6 +10,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+from liansuo.stations import limits
+from liansuo.stations.limits import Limit
 from liansuo.stations.station import Station
 
 from .physical import ballast_problem
@@ -85,6 +87,34 @@ def _target_error(kind: FaultKind, target: str, station: Station) -> str:
     return ""
 
 
+# the range of each numeric parameter (stations/limits.py says why); a broken rail's place is within its section
+PARAM_LIMITS: dict[str, Limit] = {
+    "ohm": limits.POOR_SHUNT,
+    "ohm_km": limits.BALLAST,
+    "n": limits.CAPACITOR_NUMBER,
+    "mm": limits.OBSTRUCTION,
+    "N": limits.SWITCH_FORCE,
+}
+
+
+def _param_limit(kind: str, key: str, target: str, station: Station) -> Limit:
+    if kind == "broken-rail" and key == "at":  # metres from the section's lower end
+        return Limit("a place in the section", "m", 0.0, station.section_span(target),
+                     f"section {target} runs that far from its lower end")
+    if kind == "capacitor" and key == "n":
+        count = _capacitors(station, target)
+        return Limit("a capacitor's number", "", 1.0, float(count), f"section {target} has {count}", whole=True)
+    return PARAM_LIMITS[key]
+
+
+def _capacitors(station: Station, section: str) -> int:
+    """How many compensation capacitors the live circuit of a ZPW-2000A section has (built on its span:
+    circuits/trackcircuits.py)."""
+    from .zpw2000a import capacitor_positions  # numpy: only for a capacitor fault
+
+    return len(capacitor_positions(station, section, length_m=max(station.section_span(section), 1.0)))
+
+
 def parse_fault(station: Station, kind_name: str, target: str, args: list[str]) -> Fault | str:
     """A :class:`Fault`, or the reason it cannot be injected."""
     kind = KINDS.get(kind_name)
@@ -93,6 +123,10 @@ def parse_fault(station: Station, kind_name: str, target: str, args: list[str]) 
     why = _target_error(kind, target, station)
     if why:
         return f"fault {kind_name}: {why}"
+    if kind_name == "capacitor" and station.sections[target].type.value != "zpw2000a":
+        return f"fault capacitor: section {target} is not a ZPW-2000A section"
+    if kind_name == "capacitor" and not _capacitors(station, target):
+        return f"fault capacitor: section {target} has no compensation capacitors"
     params: dict[str, str | float] = dict(kind.params)
     for arg in args:
         key, eq, value = arg.partition("=")
@@ -110,8 +144,9 @@ def parse_fault(station: Station, kind_name: str, target: str, args: list[str]) 
             if key == "ohm_km" and (why := ballast_problem(number, infinite_ok=False)):
                 return (f"fault {kind_name}: ohm_km {why}, not '{value}' (wet or dirty ballast is a few tenths of "
                         "an ohm*km, e.g. ohm_km=0.3)")
-            if number < 0 and key != "at":
-                return f"fault {kind_name}: {key} cannot be negative"
+            why = _param_limit(kind_name, key, target, station).problem(key, number, value)
+            if why:
+                return f"fault {kind_name}: {why}"
             params[key] = number
         else:
             if key in kind.choices and value not in kind.choices[key]:
@@ -125,8 +160,4 @@ def parse_fault(station: Station, kind_name: str, target: str, args: list[str]) 
         return f"fault flasher: signal {target} has no USU flasher"
     if kind_name == "axle-miscount" and station.sections[target].type.value != "axle_counter":
         return f"fault axle-miscount: section {target} is a track circuit, not counted by axle counters"
-    if kind_name == "capacitor":
-        sec = station.sections[target]
-        if sec.type.value != "zpw2000a":
-            return f"fault capacitor: section {target} is not a ZPW-2000A section"
     return Fault(kind_name, target, tuple(sorted(params.items())))

@@ -180,7 +180,8 @@ def build_circuit(station: Station, section: str, length_m: float, max_25hz_m: f
 
     carrier = sec.carrier or "1700-1"
     caps = sec.capacitors
-    model = adjusted_circuit(max(length_m, 1.0), carrier, capacitor_positions(station, section),
+    length = max(length_m, 1.0)
+    model = adjusted_circuit(length, carrier, capacitor_positions(station, section, length_m=length),
                              capacitance_uF=caps.capacitance_uF if caps else None)
     return SectionCircuit(section, sec.type, length_m, model)
 

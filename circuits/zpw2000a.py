@@ -148,14 +148,17 @@ def standard_positions(length_m: float, count: int | None = None, params: ZpwPar
     return [round((i + 0.5) * step, 6) for i in range(count)]
 
 
-def capacitor_positions(station: Station, section_id: str, params: ZpwParams = DEFAULT_PARAMS) -> list[float]:
-    """The capacitors of a section as the station file describes them (``positions``, ``count`` or ``rule``)."""
+def capacitor_positions(station: Station, section_id: str, params: ZpwParams = DEFAULT_PARAMS,
+                        length_m: float | None = None) -> list[float]:
+    """The capacitors of a section as the station file describes them (``positions``, ``count`` or ``rule``), those
+    by count or rule placed over ``length_m``, the length of the circuit they go into (by default the section's
+    span): placed on one length and solved on another, a track's own ``length`` would put them off the line."""
     caps = station.sections[section_id].capacitors
     if caps is None:
         return []
     if caps.positions is not None:
         return sorted(caps.positions)
-    length = station.section_span(section_id)
+    length = station.section_span(section_id) if length_m is None else length_m
     if caps.count is not None:
         return standard_positions(length, caps.count, params)
     return standard_positions(length, None, params) if caps.rule == "standard" else []
@@ -520,6 +523,6 @@ def section_circuit(station: Station, section_id: str, params: ZpwParams = DEFAU
     if section.type.value != "zpw2000a" or section.carrier is None:
         raise ValueError(f"section {section_id} is not a ZPW-2000A section with a carrier")
     caps = section.capacitors
-    return ZpwCircuit(station.section_length(section_id), section.carrier, capacitor_positions(station, section_id,
-                      params), params, capacitance_uF=caps.capacitance_uF if caps else None,
-                      transmitter_end=transmitter_end)
+    length = station.section_length(section_id)
+    return ZpwCircuit(length, section.carrier, capacitor_positions(station, section_id, params, length), params,
+                      capacitance_uF=caps.capacitance_uF if caps else None, transmitter_end=transmitter_end)

@@ -214,8 +214,8 @@ def section_circuit(station: Station, section_id: str, params: ZpwParams = DEFAU
     if section.type.value != "zpw2000a" or section.carrier is None:
         raise ValueError(f"section {section_id} is not a ZPW-2000A section with a carrier")
     caps = section.capacitors
-    return adjusted_circuit(station.section_length(section_id), section.carrier,
-                            capacitor_positions(station, section_id, params), params,
+    length = station.section_length(section_id)
+    return adjusted_circuit(length, section.carrier, capacitor_positions(station, section_id, params, length), params,
                             capacitance_uF=caps.capacitance_uF if caps else None)
 
 

@@ -44,6 +44,7 @@ class AutoBlock:
             for lk in station.model.links:
                 if lk.kind.value == "automatic" and sections and sections[0] in lk.sections:
                     self.line[sig.id] = lk.id
+        self.signals = _ahead_first(self.signals)
 
     def update(self, out: Outputs, clear: Callable[[str], bool], proven: Callable[[str, str], str],
                red_dark: Collection[str] = (), reversed_lines: Collection[str] = ()) -> None:
@@ -67,6 +68,28 @@ class AutoBlock:
                     changed = True
             if not changed:
                 return
+
+
+def _ahead_first(signals: list[tuple[str, tuple[str, ...], str | None]]
+                 ) -> list[tuple[str, tuple[str, ...], str | None]]:
+    """The block signals ordered so that each comes after the block signal ahead of it: one sweep of
+    :meth:`AutoBlock.update` then settles the whole chain, in time proportional to its length (in file order a change
+    at the far end would take one sweep per signal to reach the near end, a hang on a line of thousands)."""
+    by_id = {entry[0]: entry for entry in signals}
+    placed: set[str] = set()
+    out: list[tuple[str, tuple[str, ...], str | None]] = []
+    for sig, _, _ in signals:
+        path: list[str] = []
+        on_path: set[str] = set()
+        cur: str | None = sig
+        while cur is not None and cur in by_id and cur not in placed and cur not in on_path:  # a loop ends a chain
+            path.append(cur)
+            on_path.add(cur)
+            cur = by_id[cur][2]
+        for s in reversed(path):
+            placed.add(s)
+            out.append(by_id[s])
+    return out
 
 
 def cab_codes(station: Station, rules: RuleSet, routes: Iterable[RouteState],

@@ -13,9 +13,27 @@ from typing import TextIO
 from liansuo.stations.arguments import unwritable
 from liansuo.stations.exitcodes import Exit, bad_input, refuse
 from liansuo.stations.loader import load
-from liansuo.stations.source import StationError
+from liansuo.stations.source import Diagnostic, StationError
+from liansuo.stations.station import Station
 
 Add = Callable[..., argparse.ArgumentParser]
+
+
+def check_errors(station: Station) -> list[Diagnostic]:
+    """What ``liansuo table`` would refuse in a station that loaded: its ``overrides`` naming routes, turnouts or
+    enemies the topology does not give, each with the table's own message, for ``liansuo check`` (handed to it by
+    cli/main.py). The table is derived only for a file with overrides: without them deriving it cannot fail, and on
+    a hub it takes minutes."""
+    ov = station.model.overrides
+    if not (ov.protection or ov.remove_protection or ov.enemies or ov.forbid):
+        return []
+    from .table import build_table
+
+    try:
+        build_table(station)
+    except StationError as exc:
+        return exc.diagnostics
+    return []
 
 
 def cmd_table(args: argparse.Namespace) -> int:

@@ -17,6 +17,7 @@ from pathlib import Path
 from liansuo.simulation.timeparse import parse_duration
 from liansuo.simulation.trains.sumo import SumoEngineError
 from liansuo.simulation.trains.sumo_export import SumoExportError, SumoUnavailable
+from liansuo.stations import limits
 from liansuo.stations.arguments import unwritable
 from liansuo.stations.exitcodes import Exit, bad_input, refuse
 from liansuo.stations.fit import fit_all
@@ -105,6 +106,8 @@ def cmd_run(args: argparse.Namespace) -> int:
             until = parse_duration(args.until)
         except ValueError as exc:
             return refuse("run", f"--until {args.until}: {exc}", Exit.USAGE)
+        if why := limits.SCENARIO.problem("--until", until, args.until):
+            return refuse("run", why, Exit.USAGE)
     if why := plot_problem(args):
         return refuse("run", why, Exit.USAGE)
     try:

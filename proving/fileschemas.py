@@ -13,6 +13,7 @@ from typing import Annotated, Any
 from pydantic import BaseModel, ConfigDict, Field, field_validator
 
 from liansuo.simulation.timeparse import parse_duration
+from liansuo.stations import limits
 
 Step = Annotated[str, Field(description="one command of the command language (docs/commands.md), e.g. 'route X XI', "
                                         "'run 2s', 'expect signal X U'")]
@@ -57,10 +58,14 @@ class ScenarioFile(_File):
                                                   "30s, 3min, 250ms, 1h or plain seconds")
 
     @field_validator("until", mode="before", json_schema_input_type=Annotated[str, Field(pattern=DURATION_PATTERN)]
-                     | Annotated[float, Field(ge=0)])
+                     | Annotated[float, Field(ge=0, le=limits.SCENARIO.high)])
     @classmethod
     def _duration(cls, value: object) -> float:
         """A duration as text or plain seconds, in seconds."""
         if isinstance(value, bool) or not isinstance(value, str | int | float):
             raise ValueError("write a duration: 30s, 3min, 250ms, 1h or plain seconds")
-        return parse_duration(str(value))
+        seconds = parse_duration(str(value))
+        why = limits.SCENARIO.problem("until", seconds, str(value))
+        if why:
+            raise ValueError(why)
+        return seconds

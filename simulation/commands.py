@@ -13,6 +13,7 @@ from liansuo.circuits.faults import KINDS, parse_fault
 from liansuo.circuits.railgeometry import Axle
 from liansuo.interlocking.io import Result
 from liansuo.interlocking.table import Kind
+from liansuo.stations import limits
 
 from .language import Command
 from .timeparse import parse_duration
@@ -172,8 +173,9 @@ def _run(sim: World, args: list[str]) -> Result:
         seconds = parse_duration(args[0])
     except ValueError as exc:
         return Result.refuse(str(exc))
-    if seconds > 7 * 24 * 3600:
-        return Result.refuse("run at most a week of simulated time in one command")
+    why = limits.RUN.problem("a run", seconds, args[0])
+    if why:
+        return Result.refuse(f"{why}: run longer stretches in several steps")
     sim.run(seconds)
     return Result.accept(f"t = {sim.t:g} s")
 

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from liansuo.interlocking.io import Result
 from liansuo.interlocking.state import RouteStage
+from liansuo.stations import limits
 
 from .language import Command
 from .world import World
@@ -87,6 +88,9 @@ def _expect(sim: World, args: list[str]) -> Result:
             bound = float(rest[2].removesuffix("m"))
         except ValueError:
             return Result.refuse("expect odometry NAME within METRES")
+        why = limits.ODOMETRY_BOUND.problem("the bound", bound, rest[2])
+        if why:
+            return Result.refuse(f"expect odometry: {why}")
         err = tr.odometer.error_m(tr.travelled_m)
         return Result(abs(err) <= bound, f"odometry of {rest[0]} is {err:+.2f} m off" +
                       ("" if abs(err) <= bound else f", expected within {bound:g} m"))

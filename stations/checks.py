@@ -6,10 +6,12 @@ from __future__ import annotations
 
 from collections import Counter
 from collections.abc import Iterator, Sequence
+from functools import cached_property
 from itertools import pairwise
 
 import networkx as nx
 
+from . import limits
 from .fit import metres, number
 from .schema import (
     Button,
@@ -18,6 +20,7 @@ from .schema import (
     EndKind,
     Lamp,
     LinkKind,
+    Overlap,
     SectionRole,
     SignalKind,
     StationFile,
@@ -165,10 +168,28 @@ class _Checker:
                 self.err(("joints", k, "at"), f"joint '{j.id}': both its tracks leave on the same side of "
                                               f"{metres(j.at)}",
                          "a joint lies between its two tracks; check the positions")
-            if j.at2 is not None and abs(j.at2 - j.at) > 30:
+            if j.at2 is not None and abs(j.at2 - j.at) > limits.DEAD_ZONE.high:
                 self.err(("joints", k, "at2"),
-                         f"joint '{j.id}': the two rail joints are {metres(abs(j.at2 - j.at))} apart",
+                         f"joint '{j.id}': the two rail joints are {metres(abs(j.at2 - j.at))} apart (at most "
+                         f"{metres(limits.DEAD_ZONE.high)})",
                          "'at2' is the second rail's joint, normally within a few metres of 'at'")
+        self.extent()
+
+    def extent(self) -> None:
+        """The station lies within :data:`limits.EXTENT`: the models solve each section as one line, and the console
+        draws the whole station."""
+        nodes = [("ends", k, e.at) for k, e in enumerate(self.m.ends)]
+        nodes += [("joints", k, j.at) for k, j in enumerate(self.m.joints)]
+        nodes += [("turnouts", k, t.at) for k, t in enumerate(self.m.turnouts)]
+        low = min(nodes, key=lambda n: n[2])
+        high = max(nodes, key=lambda n: n[2])
+        if high[2] - low[2] > limits.EXTENT.high:
+            name = getattr(self.m, high[0])[high[1]].id
+            lowest = getattr(self.m, low[0])[low[1]].id
+            self.err((high[0], high[1], "at"), f"the station spans {metres(high[2] - low[2])}, from '{lowest}' at "
+                     f"{metres(low[2])} to '{name}' at {metres(high[2])}; {limits.EXTENT.what} is at most "
+                     f"{metres(limits.EXTENT.high)}", "check the position: a kilometre post written as metres, or a "
+                     "digit too many")
 
     def sections(self) -> None:
         known = {s.id for s in self.m.sections}
@@ -198,6 +219,7 @@ class _Checker:
                          "remove 'capacitors', or make the section 'type: zpw2000a'")
         if self.errors:
             return
+        self.zpw_lengths()
         # sections are bounded by joints or ends: tracks meeting at a turnout share a section, tracks meeting at a
         # joint do not, and the tracks of a section are connected through turnouts.
         by_node: dict[str, list[tuple[int, str]]] = {}
@@ -231,12 +253,47 @@ class _Checker:
                              "or place joints between them")
                 for a_, b_ in pairwise(items):
                     g.add_edge(self.m.tracks[a_[0]].id, self.m.tracks[b_[0]].id)
+        section_tracks: dict[str, list[str]] = {}
+        for t in self.m.tracks:
+            section_tracks.setdefault(t.section, []).append(t.id)
         for k, s in enumerate(self.m.sections):
-            tracks = [t.id for t in self.m.tracks if t.section == s.id]
+            tracks = section_tracks.get(s.id, [])
             if len(tracks) > 1 and not nx.is_connected(g.subgraph(tracks)):
                 self.err(("sections", k, "id"),
                          f"section '{s.id}' is in pieces: its tracks ({', '.join(tracks)}) are not joined through "
                          "turnouts", "each section is one stretch bounded by joints or ends; split it in two ids")
+
+    def zpw_lengths(self) -> None:
+        """A ZPW-2000A section is no longer than :data:`limits.ZPW_SECTION`, and its explicit capacitor positions lie
+        within it: from its lower end to the nearer of its far end and the sum of its tracks' lengths (a track's own
+        ``length`` may make that shorter; the models place the capacitors on whichever they solve)."""
+        pos = self.node_positions
+        span: dict[str, tuple[float, float]] = {}
+        total: dict[str, float] = {}
+        for i, _, a, b in self._track_ports():
+            t = self.m.tracks[i]
+            lo, hi = sorted((pos[a.node], pos[b.node]))
+            was = span.get(t.section, (lo, hi))
+            span[t.section] = (min(was[0], lo), max(was[1], hi))
+            total[t.section] = total.get(t.section, 0.0) + (t.length if t.length is not None else hi - lo)
+        for k, s in enumerate(self.m.sections):
+            if s.type is not CircuitType.zpw2000a or s.id not in span:
+                continue
+            run = span[s.id][1] - span[s.id][0]
+            longest = max(run, total[s.id])
+            if longest > limits.ZPW_SECTION.high:
+                self.err(("sections", k, "id"), f"ZPW-2000A section '{s.id}' is {metres(longest)} long; "
+                         f"{limits.ZPW_SECTION.what} is at most {metres(limits.ZPW_SECTION.high)}",
+                         "split it with electrical joints (tuning areas), as a real line is")
+                continue
+            reach = min(run, total[s.id])
+            caps = s.capacitors
+            for m, x in enumerate(caps.positions or [] if caps is not None else []):
+                if x > reach:
+                    self.err(("sections", k, "capacitors", "positions", m),
+                             f"section '{s.id}': capacitor {m + 1} at {metres(x)} lies beyond the section, which "
+                             f"runs {metres(reach)} from its lower end", "capacitor positions are metres from the "
+                             "section's lower (X-end) end, within the section")
 
     def pairs(self) -> None:
         members: dict[str, list[int]] = {}
@@ -277,11 +334,11 @@ class _Checker:
 
     def _reverse_legs_meet(self, a: str, b: str) -> bool:
         # walk from a.reverse through tracks and joints only
-        ports = {t.id: (parse_port(t.start), parse_port(t.end)) for t in self.m.tracks}
+        ports, at_port = self._ports
         at = Port(a, "reverse")
         seen = set()
         while True:
-            track = next((tid for tid, (p, q) in ports.items() if (p == at or q == at) and tid not in seen), None)
+            track = next((tid for tid in at_port.get(at, ()) if tid not in seen), None)
             if track is None:
                 return False
             seen.add(track)
@@ -289,13 +346,30 @@ class _Checker:
             far = q if p == at else p
             if far == Port(b, "reverse"):
                 return True
-            if far.leg is not None or far.node not in {j.id for j in self.m.joints}:
+            if far.leg is not None or far.node not in self._joint_ids:
                 return False
             at = far
 
+    @cached_property
+    def _ports(self) -> tuple[dict[str, tuple[Port, Port]], dict[Port, list[str]]]:
+        """Each track's two ports, and the tracks at each port: looked up, not searched, so that the checks take
+        time in proportion to the station's size."""
+        ports = {t.id: (parse_port(t.start), parse_port(t.end)) for t in self.m.tracks}
+        at_port: dict[Port, list[str]] = {}
+        for tid, (p, q) in ports.items():
+            at_port.setdefault(p, []).append(tid)
+            if q != p:
+                at_port.setdefault(q, []).append(tid)
+        return ports, at_port
+
+    @cached_property
+    def _joint_ids(self) -> set[str]:
+        return {j.id for j in self.m.joints}
+
     def signals(self) -> None:
-        joints = {j.id for j in self.m.joints}
+        joints = self._joint_ids
         ends = {e.id: e for e in self.m.ends}
+        sections = {x.id for x in self.m.sections}
         for k, s in enumerate(self.m.signals):
             if s.at in ends:
                 e = ends[s.at]
@@ -303,8 +377,7 @@ class _Checker:
                     self.err(("signals", k, "at"), f"signal {s.id} stands at buffer stop '{s.at}'",
                              "signals stand at joints (or at a boundary end facing into the station)")
                     continue
-                track = next(t for t in self.m.tracks if s.at in (parse_port(t.start).node, parse_port(t.end).node))
-                a, b = parse_port(track.start), parse_port(track.end)
+                a, b = self._ports[0][self._ports[1][Port(s.at)][0]]
                 far = self.node_positions[b.node if a.node == s.at else a.node]
                 into_down = far > e.at
                 if into_down != (s.direction is Direction.down):
@@ -336,7 +409,7 @@ class _Checker:
                 self.err(("signals", k, "buttons"), f"shunting signal {s.id} needs a shunt button",
                          "write 'buttons: [shunt]'")
             for m, sec in enumerate(s.approach or []):
-                if sec not in {x.id for x in self.m.sections}:
+                if sec not in sections:
                     self.err(("signals", k, "approach", m), f"signal {s.id}: approach section '{sec}' not declared",
                              "name a section listed under 'sections:'")
 
@@ -514,6 +587,11 @@ class _Checker:
         signals = {s.id for s in self.m.signals}
         sections = {s.id for s in self.m.sections}
         turnouts = {t.id for t in self.m.turnouts}
+        buttons = {b.id for b in self.m.buttons}
+        by_end: dict[str, list[Overlap]] = {}
+        for o in self.m.overlaps:
+            by_end.setdefault(o.end_signal, []).append(o)
+        ending = Counter((o.end_signal, o.end) for o in self.m.overlaps)
         for k, o in enumerate(self.m.overlaps):
             if o.end_signal not in signals:
                 self.err(("overlaps", k, "end_signal"), f"overlap at unknown signal '{o.end_signal}'",
@@ -526,15 +604,15 @@ class _Checker:
                 if t.turnout not in turnouts:
                     self.err(("overlaps", k, "turnouts", m), f"overlap turnout '{t.turnout}' is not declared",
                              "name a turnout listed under 'turnouts:'")
-            if o.end is not None and o.end not in signals and o.end not in {b.id for b in self.m.buttons}:
+            if o.end is not None and o.end not in signals and o.end not in buttons:
                 self.err(("overlaps", k, "end"), f"overlap end button '{o.end}' is not a signal or button",
                          "name the signal or button the overlap ends at (its end button)")
-            alternatives = [x for x in self.m.overlaps if x.end_signal == o.end_signal]
+            alternatives = by_end[o.end_signal]
             if len(alternatives) > 1 and o.end is None:
                 self.err(("overlaps", k), f"signal {o.end_signal} has {len(alternatives)} overlaps; each alternative "
                          "needs its 'end' (the overlap's end button the operator presses)",
                          "add 'end: BUTTON' to every overlap of this signal; the first listed is the basic one")
-            if o.end is not None and sum(x.end == o.end for x in alternatives) > 1:
+            if o.end is not None and ending[(o.end_signal, o.end)] > 1:
                 self.err(("overlaps", k, "end"), f"signal {o.end_signal} has two overlaps ending at '{o.end}'",
                          "alternative overlaps end at different buttons")
         for key in ("protection", "remove_protection"):

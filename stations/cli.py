@@ -36,6 +36,10 @@ def cmd_stations(args: argparse.Namespace) -> int:
 def cmd_check(args: argparse.Namespace) -> int:
     try:
         station = load(args.station)
+        for errors in args.more_errors:  # what the layers above refuse (the table's overrides), from cli/main.py
+            found = errors(station)
+            if found:
+                raise StationError(found)
     except StationError as exc:
         if args.format == "json":
             print_report("check", False, {"station": args.station,
@@ -82,13 +86,15 @@ def cmd_generate(args: argparse.Namespace) -> int:
     return 0
 
 
-def register(add: Add, more_warnings: tuple[Warnings, ...] = ()) -> None:
+def register(add: Add, more_warnings: tuple[Warnings, ...] = (), more_errors: tuple[Warnings, ...] = ()) -> None:
     """Add ``stations``, ``check`` and ``generate``; ``more_warnings``: design checks of higher layers that
-    ``check`` adds to the station's own (the track-circuit physics: ``circuits/zpwcli.py``)."""
+    ``check`` adds to the station's own (the track-circuit physics: ``circuits/zpwcli.py``); ``more_errors``: what
+    higher layers refuse in a station that loaded (the interlocking table: ``interlocking/cli.py``), so that
+    ``check`` accepts only what every command accepts."""
     sp = add("stations", cmd_stations, "list the bundled stations")
     sp.add_argument("--format", choices=FORMATS, default="text", help="text (default) or json")
     sp = add("check", cmd_check, "validate a station file and summarise it")
-    sp.set_defaults(more_warnings=more_warnings)
+    sp.set_defaults(more_warnings=more_warnings, more_errors=more_errors)
     sp.add_argument("station", help="bundled station name or path to a station YAML file")
     sp.add_argument("--format", choices=FORMATS, default="text", help="text (default) or json")
     sp = add("generate", cmd_generate, "write a generated station file (a hub of any size, for stress tests)")

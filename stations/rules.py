@@ -5,12 +5,13 @@ The numbers come from the rule set (``rules/NAME/design.yaml``); each warning st
 
 from __future__ import annotations
 
+from functools import cached_property
 from itertools import pairwise
 
 from liansuo.rules import DesignRules, load_rules
 
 from .fit import metres
-from .schema import CircuitType, Direction, FoulingPoint, JointKind, SignalKind
+from .schema import CircuitType, Direction, FoulingPoint, JointKind, Signal, SignalKind
 from .source import Diagnostic, Loc
 from .station import Station
 
@@ -26,15 +27,12 @@ def min_coded_length(speed_kmh: float, rules: DesignRules | None = None) -> floa
     return r.cab_code_min_time_s * speed_kmh / 3.6 + r.cab_code_margin_m
 
 
-def _index(items: list[object], ident: str) -> int:
-    return next(i for i, x in enumerate(items) if getattr(x, "id", None) == ident)
-
-
 class _Warner:
     def __init__(self, station: Station, rules: DesignRules | None = None) -> None:
         self.st = station
         self.r = rules or design_rules()
         self.out: list[Diagnostic] = []
+        self._indices: dict[str, dict[str, int]] = {}  # key -> id -> index, made on the first warning under the key
 
     def warn(self, loc: Loc, message: str, hint: str = "") -> None:
         src = self.st.source
@@ -44,7 +42,12 @@ class _Warner:
             self.out.append(src.diagnostic(loc, message, hint, severity="warning"))
 
     def loc(self, key: str, ident: str, field: str | None = None) -> Loc:
-        i = _index(getattr(self.st.model, key), ident)
+        index = self._indices.get(key)
+        if index is None:
+            index = self._indices[key] = {}
+            for i, x in enumerate(getattr(self.st.model, key)):
+                index.setdefault(getattr(x, "id", ""), i)
+        i = index[ident]
         return (key, i, field) if field else (key, i)
 
     def run(self) -> list[Diagnostic]:
@@ -140,14 +143,23 @@ class _Warner:
                     if sig.kind is SignalKind.starting and sig.direction is towards:
                         self._fouling_warn(fp.id, sig.id, abs(j_at - t_at) - abs(fp.at - t_at), clearance)
 
-    def _fouling_short(self, fp: FoulingPoint, clearance: float) -> None:
-        reach = 50.0  # how far either way a fouling point is looked for
+    _FOULING_REACH_M = 50.0  # how far either way of a starting signal a fouling point in the short form is looked for
+
+    @cached_property
+    def _starting_near(self) -> dict[str, list[Signal]]:
+        """Track -> the starting signals (in file order) that reach it within the fouling reach: each signal's
+        neighbourhood walked once, not once per fouling point."""
+        out: dict[str, list[Signal]] = {}
         for sig in self.st.model.signals:
-            if sig.kind is not SignalKind.starting or sig.at not in self.st.joints:
-                continue
+            if sig.kind is SignalKind.starting and sig.at in self.st.joints:
+                for track in self._tracks_near(sig.at, self._FOULING_REACH_M):
+                    out.setdefault(track, []).append(sig)
+        return out
+
+    def _fouling_short(self, fp: FoulingPoint, clearance: float) -> None:
+        reach = self._FOULING_REACH_M
+        for sig in self._starting_near.get(fp.track or "", []):
             j = self.st.joints[sig.at]
-            if fp.track not in self._tracks_near(j.id, reach):
-                continue
             d = (fp.at - j.at) * (1.0 if sig.direction is Direction.down else -1.0)
             if -reach < d < clearance:
                 self._fouling_warn(fp.id, sig.id, d, clearance)
@@ -187,14 +199,27 @@ class _Warner:
             return own, "its speed_kmh"
         if any(t in main for t in st.section_tracks[section]):
             return line, "line speed on the main line"
-        tracks = set(st.section_tracks[section])
-        onto = [t for t in st.turnouts if st.turnout_section.get(t) == section
-                or any(tr in tracks for tr, _ in st.leg_chain(t, "reverse"))]
+        onto = self._onto.get(section, [])
         if not onto:
             return self.r.coding_speed_kmh, "no turnout leads onto it"
         fastest = max(onto, key=lambda t: st.diverging_speed_kmh(t, self.r))
         v = min(line, st.diverging_speed_kmh(fastest, self.r))
         return v, f"side line, over turnout {fastest}"
+
+    @cached_property
+    def _onto(self) -> dict[str, list[str]]:
+        """Section -> the turnouts that lead onto it: it is their own section, or their reverse leg reaches it across
+        joints. Worked out once for every turnout, not once per coded section."""
+        st = self.st
+        out: dict[str, list[str]] = {}
+        for t in st.turnouts:
+            reached = {st.tracks[tr].section for tr, _ in st.leg_chain(t, "reverse")}
+            own = st.turnout_section.get(t)
+            if own is not None:
+                reached.add(own)
+            for sec in reached:
+                out.setdefault(sec, []).append(t)
+        return out
 
     def _main_line(self) -> set[str]:
         """The tracks of the straight way from each boundary (facing turnouts normal), to the far end of the line."""

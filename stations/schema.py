@@ -15,6 +15,8 @@ from pydantic import AfterValidator, BaseModel, BeforeValidator, ConfigDict, Fie
 
 from liansuo.rules.inputlimits import LIMITS
 
+from . import limits
+
 _ID_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_\-/]*$")
 _KM_RE = re.compile(r"^K(\d+)\+(\d+(?:\.\d+)?)$")
 
@@ -66,10 +68,22 @@ def _position(value: object) -> object:
 
 
 # A position: metres along the line, or a kilometre post ``K12+345.6``.
-Position = Annotated[float, BeforeValidator(_position), WithJsonSchema(
-    {"anyOf": [{"type": "number"}, {"type": "string", "pattern": _KM_RE.pattern}],
+# Every number below has its range from :mod:`.limits`, where each limit says why.
+Position = Annotated[float, BeforeValidator(_position), limits.POSITION.check(), WithJsonSchema(
+    {"anyOf": [{"type": "number", "minimum": limits.POSITION.low, "maximum": limits.POSITION.high},
+               {"type": "string", "pattern": _KM_RE.pattern}],
      "description": "metres (down direction increasing) or a kilometre post such as K12+345.6"})]
 Metres = Annotated[float, Field(gt=0), BeforeValidator(lambda v: float(v) if type(v) is int else v)]
+TrackLength = Annotated[Metres, limits.TRACK_LENGTH.field(), limits.TRACK_LENGTH.check()]
+Speed = Annotated[float, limits.SPEED.field(), limits.SPEED.check()]
+Release = Annotated[float, limits.RELEASE.field(), limits.RELEASE.check()]
+Coordinate = Annotated[float, limits.DIAGRAM.field(), limits.DIAGRAM.check()]
+TuningArea = Annotated[Metres, limits.TUNING_AREA.field(), limits.TUNING_AREA.check()]
+DeadZone = Annotated[float, limits.DEAD_ZONE.field(), limits.DEAD_ZONE.check()]
+Capacitance = Annotated[float, limits.CAPACITANCE.field(), limits.CAPACITANCE.check()]
+Stretch = Annotated[float, limits.STRETCH.field(), limits.STRETCH.check()]
+StopWindow = Annotated[float, limits.STOP_WINDOW.field(), limits.STOP_WINDOW.check()]
+SlipLength = Annotated[Metres, limits.DOUBLE_SLIP_LENGTH.field(), limits.DOUBLE_SLIP_LENGTH.check()]
 
 
 class Strict(BaseModel):
@@ -93,8 +107,8 @@ class Name(Strict):
 class Draw(Strict):
     """Optional schematic coordinates (columns, rows) for the console's station diagram."""
 
-    x: float
-    y: float
+    x: Coordinate
+    y: Coordinate
 
 
 class EndKind(StrEnum):
@@ -127,8 +141,8 @@ class Joint(Strict):
     at: Position
     at2: Position | None = None
     kind: JointKind = JointKind.insulated
-    tuning_area_m: Metres | None = None
-    dead_zone_m: Annotated[float, Field(ge=0)] | None = None
+    tuning_area_m: TuningArea | None = None
+    dead_zone_m: DeadZone | None = None
     draw: Draw | None = None
 
 
@@ -168,8 +182,8 @@ class Track(Strict):
     start: str = Field(alias="from")
     end: str = Field(alias="to")
     section: Id
-    length: Metres | None = None
-    row: float | None = None  # schematic row, 0 = the main line
+    length: TrackLength | None = None
+    row: Coordinate | None = None  # schematic row, 0 = the main line
 
     model_config = ConfigDict(extra="forbid", strict=True, frozen=True, populate_by_name=True,
                               allow_inf_nan=False)
@@ -195,9 +209,10 @@ class Capacitors(Strict):
     by the standard rule, or ``rule: standard`` (about every 100 m, half a spacing at the ends, only over 300 m)."""
 
     count: Annotated[int, Field(ge=0, le=60)] | None = None
-    positions: list[Annotated[float, Field(ge=0)]] | None = None
+    positions: Annotated[list[Annotated[float, Field(ge=0, le=limits.ZPW_SECTION.high)]],
+                         Field(max_length=60)] | None = None  # within the section: stations/checks.py
     rule: Literal["standard"] | None = None
-    capacitance_uF: Annotated[float, Field(gt=0)] | None = None
+    capacitance_uF: Capacitance | None = None
 
 
 _CARRIER_RE = re.compile(r"^(1700|2000|2300|2600)-(1|2)$")
@@ -223,7 +238,7 @@ class Section(Strict):
     carrier: Carrier | None = None
     coded: bool = False  # 电码化: carries cab-signal codes
     capacitors: Capacitors | None = None
-    speed_kmh: Annotated[float, Field(gt=0, le=400)] | None = None
+    speed_kmh: Speed | None = None
     name: str | None = None
 
 
@@ -273,7 +288,7 @@ class Signal(Strict):
     usu: bool = False  # may show the flashing yellow USU (needs a U and a U2 lamp)
     flasher: Literal["relay", "electronic"] = "electronic"  # USU flasher: classic RC relay (SNJ/SNJJ) or electronic
     buttons: list[Button] = Field(default_factory=list)
-    release_s: Annotated[float, Field(gt=0)] | None = None  # manual release delay override
+    release_s: Release | None = None  # manual release delay override
     approach: list[Id] | None = None  # override of the approach section(s) (接近区段)
     draw: Draw | None = None
 
@@ -315,8 +330,8 @@ class Marker(Strict):
     kind: MarkerKind
     track: Id
     at: Position
-    length_m: Annotated[float, Field(ge=0)] = 0.0  # for sanding / washing stretches
-    speed_kmh: Annotated[float, Field(gt=0)] | None = None  # speed limit over it, where it has one
+    length_m: Stretch = 0.0  # for sanding / washing stretches
+    speed_kmh: Speed | None = None  # speed limit over it, where it has one
 
 
 class Side(StrEnum):
@@ -335,7 +350,7 @@ class Platform(Strict):
     id: Id
     section: Id
     screen_doors: list[ScreenDoors] = Field(default_factory=list)
-    stop_window_m: Annotated[float, Field(gt=0)] = 0.5
+    stop_window_m: StopWindow = 0.5
     name: str | None = None
 
 
@@ -389,7 +404,7 @@ class DoubleSlip(Strict):
 
     id: Id
     at: Position  # the centre, where the two straight roads cross
-    length: Metres  # from the low-end turnouts (at - length/2) to the high-end ones (at + length/2)
+    length: SlipLength  # from the low-end turnouts (at - length/2) to the high-end ones (at + length/2)
     number: Annotated[int, Field(ge=6, le=62)]
     machine: Machine
     section: Id  # the track-circuit section it lies in, with the tracks at its four points
@@ -462,7 +477,7 @@ class Overlap(Strict):
     end: Id | None = None  # the overlap's end button (a signal or button); required for alternatives
     sections: list[Id] = Field(min_length=1)
     turnouts: list[TurnoutAt] = Field(default_factory=list)
-    release_s: Annotated[float, Field(gt=0)] | None = None
+    release_s: Release | None = None
 
 
 class Grade(Strict):
@@ -484,7 +499,7 @@ class StationFile(Strict):
     name: Name
     description: str = ""
     line: Literal["single", "double"] = "single"
-    line_speed_kmh: Annotated[float, Field(gt=0, le=400)] = 120.0
+    line_speed_kmh: Speed = 120.0
     emu: bool = False  # EMUs call here: fouling-point clearance 5 m
     ends: list[End] = Field(min_length=1)
     joints: list[Joint] = Field(default_factory=list)

@@ -140,7 +140,7 @@ def test_dead_capacitor_on_a_long_zpw_section_lowers_the_receive_voltage(gaotie:
     gaotie("expect section X2JG free")  # still above the drop level: no red band
     gaotie("repair capacitor X2JG", "fault capacitor X2JG n=7 mode=short", "run 1s", "expect section X2JG occupied",
            "expect signal 1217 H")  # the block signal in rear of it closes
-    gaotie.refused("fault capacitor IG n=99", "n must be 1..7")
+    gaotie.refused("fault capacitor IG n=99", "n must be a whole number from 1 to 7")
 
 
 def test_route_over_sections_released_behind_a_train_can_be_set_before_the_train_route_ends(

@@ -8,6 +8,7 @@ from typing import Protocol
 
 from liansuo.interlocking.io import Result
 from liansuo.interlocking.table import InterlockingTable
+from liansuo.stations import limits
 from liansuo.stations.schema import Direction
 from liansuo.stations.station import Station
 
@@ -50,7 +51,10 @@ USAGE = {
     "reverse": "reverse NAME (change the direction of travel; the train must stand)",
 }
 
-_NUMBERS = {"length": "length", "axles": "axles", "vmax": "vmax"}
+# the range of each number a train is placed with (stations/limits.py says why); front is a position on the track,
+# checked where the train is placed
+_TRAIN_LIMITS = {"length": limits.TRAIN_LENGTH, "axles": limits.AXLES, "vmax": limits.TRAIN_SPEED,
+                 "back": limits.BACK, "front": limits.POSITION}
 
 
 def _train(sim: Yard, args: list[str]) -> Result:
@@ -85,8 +89,9 @@ def _train(sim: Yard, args: list[str]) -> Result:
                 return Result.refuse(f"{k} must be a number, not '{params[k]}'")
             if not math.isfinite(nums[k]):
                 return Result.refuse(f"{k} must be a finite number, not '{params[k]}'")
-            if nums[k] <= 0 and k != "front":
-                return Result.refuse(f"{k} must be positive")
+            why = _TRAIN_LIMITS[k].problem(k, nums[k], params[k])
+            if why:
+                return Result.refuse(f"train {name}: {why}")
     mode = params.get("mode", "manual")
     if mode not in MODES:
         return Result.refuse(f"mode must be one of {', '.join(MODES)}")
@@ -209,6 +214,9 @@ def _slip(sim: Yard, args: list[str]) -> Result:
         return Result.refuse(f"slip: {exc}" if "duration" in str(exc) else "RATIO must be a number, e.g. 0.3 or -0.3")
     if not -0.9 <= ratio <= 2.0:
         return Result.refuse("RATIO must lie between -0.9 (a locked wheel slides) and 2 (a wheel spinning 3x)")
+    why = limits.SLIP.problem("the slip's duration", seconds, args[2])
+    if why:
+        return Result.refuse(f"slip: {why}")
     tr = sim.fleet.trains[name]
     tr.slip_ratio, tr.slip_until = ratio, sim.fleet.t + seconds
     tr.slip_from = sim.fleet.t
