@@ -25,7 +25,7 @@ Add = Callable[..., argparse.ArgumentParser]
 
 # kind -> the module that generates and attempts it (NAME, strategy(), attempt(sample))
 KINDS: dict[str, str] = {
-    "stations": "liansuo.proving.fuzzstations",
+    "stations": "liansuo.cli.fuzzstations",
     "commands": "liansuo.simulation.commandfuzz",
     "recordings": "liansuo.simulation.fuzzrecordings",
 }

@@ -577,6 +577,10 @@ class _Checker:
                 self.err(("links", k, "kind"), f"64D semi-automatic block line {lk.id} names no sections: its block "
                          "machine sees our train depart by its departure section",
                          "name the departure section (the first a departing train occupies) under 'sections:'")
+            if lk.kind is LinkKind.automatic and not lk.sections:
+                self.err(("links", k, "kind"), f"automatic block line {lk.id} names no sections: the interlocking "
+                         "reads the line's block sections to let a train depart or be received",
+                         "list the line's sections under 'sections:' (the departure or approach section first)")
             roles = {roles_of[sec] for sec in lk.sections if sec in roles_of}
             if lk.kind is LinkKind.automatic and roles >= {SectionRole.approach, SectionRole.departure}:
                 self.err(("links", k, "sections"), f"link {lk.id} mixes approach and departure sections, so its "

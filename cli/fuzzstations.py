@@ -14,7 +14,6 @@ character reaching the terminal. An exception from the product escapes as it is 
 
 from __future__ import annotations
 
-import argparse
 import copy
 import io
 import math
@@ -23,7 +22,7 @@ import tempfile
 from collections.abc import Callable
 from contextlib import redirect_stderr, redirect_stdout
 from dataclasses import dataclass
-from functools import cache, partial
+from functools import cache
 from importlib.resources import files
 from pathlib import Path
 from typing import Any
@@ -31,12 +30,9 @@ from typing import Any
 import yaml
 from hypothesis import strategies as st
 
-from liansuo.circuits import zpwcli
-from liansuo.interlocking import cli as table_cli
-from liansuo.stations import cli as station_cli
 from liansuo.stations.exitcodes import Exit
 
-from .verify import cli as verify_cli
+from .main import build_parser
 
 NAME = "stations"
 EXAMPLES = Path(str(files("liansuo"))) / "examples" / "stations"
@@ -243,25 +239,9 @@ def strategy() -> st.SearchStrategy[StationSample]:
 
 # ---- feeding it to the commands ---------------------------------------------------------------------------------
 @cache
-def _parser() -> argparse.ArgumentParser:
-    """``check``, ``table`` and ``verify`` registered as ``liansuo`` registers them (cli/main.py)."""
-    parser = argparse.ArgumentParser(prog="liansuo")
-    sub = parser.add_subparsers()
-
-    def add(name: str, handler: Callable[[argparse.Namespace], int], help_: str) -> argparse.ArgumentParser:
-        sp = sub.add_parser(name, help=help_)
-        sp.set_defaults(handler=handler)
-        return sp
-
-    partial(station_cli.register, more_warnings=(zpwcli.check_warnings,))(add)
-    table_cli.register(add)
-    verify_cli.register(add)
-    return parser
-
-
 def run(*argv: str) -> tuple[int, str, str]:
     """``liansuo ARGV``'s exit status, stdout and stderr."""
-    args = _parser().parse_args(argv)
+    args = build_parser().parse_args(argv)  # the command line itself, as installed
     out, err = io.StringIO(), io.StringIO()
     with redirect_stdout(out), redirect_stderr(err):
         code = int(args.handler(args))
