@@ -2,7 +2,8 @@
 
 Textual is imported only when a console actually starts, so the rest of the command line stays quick. Every argument
 (the station, ``--speed``, ``--exercise``, ``--record``, the recording) is checked before a console starts: a bad one
-ends the command with its one-line message and exit status (docs/commands.md, "Exit status").
+ends the command with its one-line message and exit status (docs/commands.md, "Exit status"). A console that had an
+internal error, or stopped on one, prints the tracebacks on stderr when it closes and exits with status 1.
 """
 
 from __future__ import annotations
@@ -11,11 +12,15 @@ import argparse
 import sys
 from collections.abc import Callable
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from liansuo.stations.arguments import positive_number, unwritable
 from liansuo.stations.exitcodes import Exit, bad_input, refuse
 from liansuo.stations.source import StationError
 from liansuo.stations.station import Station
+
+if TYPE_CHECKING:
+    from .safeapp import SafeApp
 
 Handler = Callable[[argparse.Namespace], int]
 Add = Callable[[str, Handler, str], argparse.ArgumentParser]
@@ -77,6 +82,16 @@ def cmd_tui(args: argparse.Namespace) -> int:
     except OSError as exc:
         return refuse("tui", str(exc), Exit.BAD_INPUT)
     app.run()
+    return closed(app, "tui")
+
+
+def closed(app: SafeApp, command: str) -> int:
+    """After the console closed: 0, or every internal error's traceback on stderr and :attr:`Exit.FAILED`."""
+    if app.incidents:
+        print(app.incidents.report(command), file=sys.stderr)
+        return int(Exit.FAILED)
+    if app.return_code:
+        return refuse(command, f"the console stopped with status {app.return_code}", Exit.FAILED)
     return 0
 
 
@@ -111,5 +126,6 @@ def cmd_replay(args: argparse.Namespace) -> int:
         return 0
     from .replay import ReplayApp
 
-    ReplayApp(rec, speed=args.speed).run()
-    return 0
+    replay = ReplayApp(rec, speed=args.speed)
+    replay.run()
+    return closed(replay, "replay")
