@@ -27,6 +27,7 @@ Add = Callable[..., argparse.ArgumentParser]
 KINDS: dict[str, str] = {
     "stations": "liansuo.cli.fuzzstations",
     "commands": "liansuo.simulation.commandfuzz",
+    "console": "liansuo.tui.fuzz",
     "recordings": "liansuo.simulation.fuzzrecordings",
 }
 

@@ -240,9 +240,9 @@ def test_a_command_that_runs_past_the_end_is_stopped_there(session: tuple[Path, 
                                                            capsys: pytest.CaptureFixture[str]) -> None:
     path, lines = session
     i = line_of(lines, "cmd", "release X")
-    write(path, edit(lines, i, line="run 100h"))
+    write(path, edit(lines, i, line="run 50min"))
     code, out, _ = replay(capsys, str(path))
-    assert code == 1 and f"{path}:{i + 1}: 'run 100h' (t = 7 s) runs past the end of the recording (cycle 68" in out
+    assert code == 1 and f"{path}:{i + 1}: 'run 50min' (t = 7 s) runs past the end of the recording (cycle 68" in out
 
 
 def test_escape_sequences_in_a_recording_are_shown_written_out(session: tuple[Path, list[str]],

@@ -1,4 +1,4 @@
-"""`make run` in a real terminal (tmux, 80x24): the console shows the default station and ctrl+q quits cleanly.
+"""`make run` in a real terminal (tmux, 80x24): the console shows the default station, ctrl+q asks, y quits cleanly.
 
 Skipped when tmux is not installed. By default it runs `make run` in this checkout; with
 ``LIANSUO_TMUX_FRESH_CLONE=1`` it clones the repository first and lets `make run` build its own .venv (slow: it
@@ -49,7 +49,7 @@ def _make_command(repo: Path) -> str:
     return "make run"
 
 
-def test_make_run_shows_the_station_and_ctrl_q_quits(tmp_path: Path) -> None:
+def test_make_run_shows_the_station_and_ctrl_q_asks_then_quits(tmp_path: Path) -> None:
     repo = ROOT
     timeout = 60.0
     if os.environ.get("LIANSUO_TMUX_FRESH_CLONE") == "1":
@@ -67,6 +67,9 @@ def test_make_run_shows_the_station_and_ctrl_q_quits(tmp_path: Path) -> None:
         assert "教培站" in screen and "IG" in screen, screen
         assert "Traceback" not in screen
         _tmux("send-keys", "-t", session, "C-q")
+        screen = _wait_for(session, lambda s: "Quit the console?" in s, 20.0)
+        assert "Quit the console?" in screen and "LIANSUO-EXIT=" not in screen, screen
+        _tmux("send-keys", "-t", session, "y")
         screen = _wait_for(session, lambda s: "LIANSUO-EXIT=" in s, 20.0)
         assert "LIANSUO-EXIT=0" in screen, screen
         assert "Traceback" not in screen

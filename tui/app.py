@@ -4,6 +4,9 @@ The console is a thin view: everything it changes goes through the command langu
 reads the simulation only to draw it. It paces ``sim.step()`` against the wall clock (1x real time by default);
 the layers below never read the wall clock. A recorder may be attached to write the session to a file, and the same
 app plays a recording back (:mod:`tui.replay`).
+
+No input ends it unasked: a long ``run`` goes in slices (:mod:`tui.longrun`), an error nobody expected is shown in the
+alarm panel and the console carries on (:mod:`tui.guard`, :mod:`tui.incidents`), and every way out asks first.
 """
 
 from __future__ import annotations
@@ -14,7 +17,7 @@ from pathlib import Path
 from typing import ClassVar
 
 from rich.text import Text
-from textual.app import App, ComposeResult
+from textual.app import ComposeResult
 from textual.binding import Binding, BindingType
 from textual.containers import Horizontal, Vertical
 from textual.widgets import Footer
@@ -23,14 +26,18 @@ from liansuo.simulation import Result
 from liansuo.simulation.exercise import Exercise, GoalCheck, bundled_exercises, check_goal, parse_exercise
 from liansuo.simulation.recording import FileRecorder
 from liansuo.simulation.sim import Simulation
+from liansuo.stations.printable import printable
 from liansuo.stations.source import StationError
 
 from .diagram import Diagram
 from .dialogs import ConfirmScreen, HelpScreen, MenuScreen, PasswordScreen
+from .incidents import KEY_PREFIX, Incident
 from .instructor import InstructorPanel
 from .layout import Ref
+from .longrun import LongRun, requested_run
 from .operate import MODES, Operator, Outcome
 from .panels import (
+    AlarmLine,
     AlarmPanel,
     CommandBar,
     EventLog,
@@ -41,16 +48,26 @@ from .panels import (
     clock_text,
     read_alarms,
 )
+from .safeapp import SafeApp
 
 SPEEDS = (0.25, 0.5, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0, 64.0)
 TICK_S = 0.125  # redraw at 8 Hz: often enough for the USU flash (35 per minute)
 MAX_STEPS_PER_TICK = 400
 PASSWORD_ENV = "LIANSUO_INSTRUCTOR_PASSWORD"
+QUIT_WORDS = ("quit", "exit")  # typed in the command bar, they close the console (after asking), as ctrl+q does
 
 
-class ConsoleApp(App[None]):
+def who(source: str) -> str:
+    """How the event log names who sent a command."""
+    return {"trainee": "trainee>", "instructor": "instr.>", "exercise": "lesson>"}.get(source, f"{source}>")
+
+
+class ConsoleApp(SafeApp):
     TITLE = "liansuo 联锁"
+    # Text too long for its widget ends in an ellipsis instead of folding: Textual cannot fold a word into a width of
+    # 0, so a window squeezed through 1x1 with a dialog or the palette open would fail to lay out.
     CSS = """
+    * { text-overflow: ellipsis; }
     Screen { layout: vertical; background: #0c0f12; }
     #main { height: 1fr; }
     #left { width: 1fr; }
@@ -96,6 +113,7 @@ class ConsoleApp(App[None]):
         self.warm_up = True
         self._status = Text()
         self.instructor_panel: InstructorPanel | None = None  # mounted the first time instructor mode opens
+        self.long_run: LongRun | None = None
         self.recorder: FileRecorder | None = None
         if record is not None:
             self.recorder = FileRecorder(self.sim, record)
@@ -146,13 +164,34 @@ class ConsoleApp(App[None]):
         if self.recorder is not None:
             self.recorder.close()
 
+    # ---- what the safe shell asks of the console (tui/safeapp.py) ----
+    def sim_time(self) -> float | None:
+        return self.sim.t
+
+    def show_incident(self, incident: Incident, where: str) -> None:
+        self.say(f"internal error in {where}: {incident.summary} (see the alarms; the console carries on)", False)
+        self.alarm_panel.show(self.alarm_lines(), True)
+
+    def quit_question(self) -> str:
+        extra = []
+        if self.recorder is not None:
+            extra.append(f"the recording {self.recorder.path} is closed")
+        if self.long_run is not None:
+            extra.append(f"'{self.long_run.line}' stops")
+        return "退出 Quit the console?" + (f" ({'; '.join(extra)})" if extra else "")
+
+    def quit_declined(self) -> None:
+        self.say("the console stays open")
+
     # ---- the clock ----
     def tick(self) -> None:
         now = time.monotonic()
         elapsed, self._wall = min(now - self._wall, 1.0), now
         self._ticks += 1
         try:
-            if not self.paused:
+            if self.long_run is not None:
+                self.continue_run()
+            elif not self.paused:
                 self._debt += elapsed * self.speed
                 n = min(int(self._debt / self.sim.cycle_s), MAX_STEPS_PER_TICK)
                 self._debt = min(self._debt - n * self.sim.cycle_s, self.sim.cycle_s * MAX_STEPS_PER_TICK)
@@ -160,11 +199,54 @@ class ConsoleApp(App[None]):
             self.refresh_views()
         except Exception as exc:  # no traceback on the screen: stop the clock and say what happened
             self.paused = True
-            self.say(f"internal error, clock paused: {type(exc).__name__}: {exc}", False)
+            self.long_run = None
+            incident = self.report_unexpected(exc, "the clock")
+            self.say(f"internal error, clock paused: {incident.summary} (see the alarms)", False)
+
+    def start_run(self, line: str, source: str, seconds: float) -> Result:
+        """A ``run`` the language accepted: its first slice now, the rest on the clock's ticks."""
+        self.long_run = LongRun.of(line, source, seconds, self.sim.cycle_s)
+        self.continue_run()
+        if self.long_run is None:  # done in its first slice
+            return self.sim.last_result or Result.accept(f"t = {self.sim.t:g} s")
+        result = Result.accept(self.long_run.progress())  # the status line shows how far it has gone
+        self.say(result.message, True)
+        return result
+
+    def continue_run(self) -> None:
+        run = self.long_run
+        if run is None:
+            return
+        run.advance(self.advance_one)
+        if run.finished:
+            self.finish_run()
+
+    def stop_run(self) -> None:
+        """Esc while a long ``run`` goes on: it stops where it is."""
+        if self.long_run is not None:
+            self.finish_run()
+
+    def finish_run(self) -> None:
+        run, self.long_run = self.long_run, None
+        if run is None:
+            return
+        answer = run.answer(self.sim.t)
+        self.sim.last_result = answer  # what 'expect accepted' checks, as if the language had run it at once
+        self._wall, self._debt = time.monotonic(), 0.0
+        if not run.finished:
+            self.log_panel.add(f"{self.sim.t:9.2f} {'stopped':8} {answer.message}", "#ffd700")
+        self.say(answer.message, True)
+
+    def advance_one(self) -> None:
+        self.advance(1)
 
     def advance(self, cycles: int) -> None:
         for _ in range(cycles):
             self.sim.step()
+
+    def alarm_lines(self) -> list[AlarmLine]:
+        """The console's own errors first, then the interlocking's and the world's alarms."""
+        return self.incidents.alarms() + read_alarms(self.sim, self.acknowledged)
 
     def refresh_views(self) -> None:
         sim = self.sim
@@ -172,7 +254,7 @@ class ConsoleApp(App[None]):
         log = self.log_panel
         for t, kind, text in self.events.new(sim):
             log.add(f"{t:9.2f} {kind:8} {text}", "#ff6060" if kind == "alarm" else "")
-        alarms = read_alarms(sim, self.acknowledged)
+        alarms = self.alarm_lines()
         self.alarm_panel.show(alarms, int(sim.t * 2) % 2 == 0)
         if self.exercise is not None and self._ticks % 8 == 0:
             self.check_exercise()
@@ -187,9 +269,13 @@ class ConsoleApp(App[None]):
     def status_text(self, alarms: int) -> Text:
         sim = self.sim
         out = Text(no_wrap=True, overflow="ellipsis")
-        out.append(f" {sim.station.model.name.zh} {sim.station.model.name.en} ", style="bold")
+        out.append(printable(f" {sim.station.model.name.zh} {sim.station.model.name.en} "), style="bold")
         out.append(f"│ t {clock_text(sim.t)} ")
-        out.append("⏸ paused " if self.paused else "▶ ", style="bold #ffd700" if self.paused else "#80ff80")
+        if self.long_run is not None:
+            share = 100 * self.long_run.done // max(1, self.long_run.cycles)
+            out.append(f"⏩ {self.long_run.line} {share}% (Esc stops) ", style="bold #80d0ff")
+        else:
+            out.append("⏸ paused " if self.paused else "▶ ", style="bold #ffd700" if self.paused else "#80ff80")
         out.append(f"{self.speed:g}x ")
         if alarms:
             out.append(f"│ ⚠ {alarms} alarm{'s' if alarms > 1 else ''} ", style="bold #ff4040")
@@ -200,7 +286,7 @@ class ConsoleApp(App[None]):
                    else "")
         if self.exercise is not None:
             done = self.goal_reached_at is not None
-            out.append(f"│ {self.exercise.title}: {'goal reached' if done else 'in progress'} ",
+            out.append(printable(f"│ {self.exercise.title}: {'goal reached' if done else 'in progress'} "),
                        style="bold #40e070" if done else "#ffd700")
         if self.recorder is not None:
             out.append("│ ● REC ", style="#ff5050")
@@ -208,19 +294,32 @@ class ConsoleApp(App[None]):
 
     # ---- commands ----
     def send(self, line: str, source: str = "trainee") -> Result:
-        """Send one line of the command language; log it with its answer and show the answer."""
+        """Send one line of the command language; log it with its answer and show the answer. A ``run`` sent by a
+        person goes in slices (:mod:`tui.longrun`); while one goes on, other commands wait for it."""
         line = line.strip()
         if not line:
             return Result.accept("")
+        if self.long_run is not None:
+            why = f"wait: '{self.long_run.line}' is running ({self.long_run.progress()})"
+            self.log_panel.add(f"{self.sim.t:9.2f} {'refused':8} {line}: {why}", "#ff8080")
+            self.say(why, False)
+            return Result.refuse(why)
         if self.recorder is not None:
             self.recorder.source = source
         try:
+            seconds = requested_run(self.sim, line) if source in ("trainee", "instructor") else None
+            if seconds is not None:
+                self.log_panel.add(f"{self.sim.t:9.2f} {who(source):8} {line}", "#9fd3ff")
+                result = self.start_run(line, source, seconds)
+                self.refresh_views()
+                return result
             result = self.sim.command(line)
         except Exception as exc:  # a command must never bring the console down
-            result = Result.refuse(f"internal error: {type(exc).__name__}: {exc}")
+            self.long_run = None
+            incident = self.report_unexpected(exc, f"the command '{line.split()[0]}'")
+            result = Result.refuse(f"internal error: {incident.summary}")
         log = self.log_panel
-        who = {"trainee": "trainee>", "instructor": "instr.>", "exercise": "lesson>"}.get(source, f"{source}>")
-        log.add(f"{self.sim.t:9.2f} {who:8} {line}", "#9fd3ff" if source == "trainee" else "#d0a0ff")
+        log.add(f"{self.sim.t:9.2f} {who(source):8} {line}", "#9fd3ff" if source == "trainee" else "#d0a0ff")
         if not result.ok:
             log.add(f"{self.sim.t:9.2f} {'refused':8} {result.message}", "#ff8080")
         if result.message or not result.ok:
@@ -245,14 +344,14 @@ class ConsoleApp(App[None]):
             self.submit_line(line)
 
     def submit_line(self, line: str) -> None:
+        if line.split() and line.split()[0] in QUIT_WORDS and len(line.split()) == 1:
+            self.call_later(self.action_quit)
+            return
         self.send(line, "instructor" if self.instructor else "trainee")
 
     # ---- operating by buttons ----
     def on_diagram_pressed(self, event: Diagram.Pressed) -> None:
-        try:
-            self.press(event.ref)
-        except Exception as exc:
-            self.say(f"internal error: {type(exc).__name__}: {exc}", False)
+        self.press(event.ref)  # an error here is reported by the guard (tui/guard.py)
 
     def press(self, ref: Ref) -> None:
         panel = self.instructor_panel
@@ -313,6 +412,10 @@ class ConsoleApp(App[None]):
         self.command_bar.focus()
 
     def action_escape(self) -> None:
+        if self.long_run is not None:
+            self.stop_run()
+            self.refresh_views()
+            return
         if self.command_bar.has_focus:
             self.diagram.focus()
             return
@@ -338,10 +441,13 @@ class ConsoleApp(App[None]):
 
     def action_acknowledge(self) -> None:
         self.acknowledged |= {a.key for a in read_alarms(self.sim, set())}
+        self.incidents.acknowledge()
         self.refresh_views()
 
     def on_alarm_panel_acknowledge(self, event: AlarmPanel.Acknowledge) -> None:
-        if event.key:
+        if event.key and event.key.startswith(KEY_PREFIX):
+            self.incidents.acknowledge(event.key)
+        elif event.key:
             self.acknowledged.add(event.key)
         self.refresh_views()
 
@@ -366,8 +472,11 @@ class ConsoleApp(App[None]):
 
     async def set_instructor(self, on: bool) -> None:
         if on and self.instructor_panel is None:
+            main = self.screen_stack[0].query_one("#main")
+            if not main.is_attached:
+                return  # the console is closing (quit answered yes, F2 typed before it closed): nothing to open
             self.instructor_panel = InstructorPanel(lambda: self.sim, self._exercise_files(), id="instructor")
-            await self.screen_stack[0].query_one("#main").mount(self.instructor_panel)
+            await main.mount(self.instructor_panel)
             if self.recorder is not None:
                 self.instructor_panel.show_recording(f"recording to {self.recorder.path}")
             self._show_goal()
@@ -386,6 +495,7 @@ class ConsoleApp(App[None]):
         self.load_exercise(event.path)
 
     def load_exercise(self, path: str) -> None:
+        self.stop_run()
         try:
             ex = parse_exercise(path)
         except StationError as exc:

@@ -2,12 +2,14 @@
 
 Textual is imported only when a console actually starts, so the rest of the command line stays quick. Every argument
 (the station, ``--speed``, ``--exercise``, ``--record``, the recording) is checked before a console starts: a bad one
-ends the command with its one-line message and exit status (docs/commands.md, "Exit status").
+ends the command with its one-line message and exit status (docs/commands.md, "Exit status"). A console that had an
+internal error, or stopped on one, prints the tracebacks on stderr when it closes and exits with status 1.
 """
 
 from __future__ import annotations
 
 import argparse
+import sys
 from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -20,6 +22,8 @@ from liansuo.stations.station import Station
 
 if TYPE_CHECKING:
     from liansuo.simulation.recordingfile import Recording
+
+    from .safeapp import SafeApp
 
 Handler = Callable[[argparse.Namespace], int]
 Add = Callable[[str, Handler, str], argparse.ArgumentParser]
@@ -84,6 +88,16 @@ def cmd_tui(args: argparse.Namespace) -> int:
     except OSError as exc:
         return refuse("tui", str(exc), Exit.BAD_INPUT)
     app.run()
+    return closed(app, "tui")
+
+
+def closed(app: SafeApp, command: str) -> int:
+    """After the console closed: 0, or every internal error's traceback on stderr and :attr:`Exit.FAILED`."""
+    if app.incidents:
+        print(app.incidents.report(command), file=sys.stderr)
+        return int(Exit.FAILED)
+    if app.return_code:
+        return refuse(command, f"the console stopped with status {app.return_code}", Exit.FAILED)
     return 0
 
 
@@ -103,8 +117,9 @@ def cmd_replay(args: argparse.Namespace) -> int:
         return _verify(args, rec, station)
     from .replay import ReplayApp
 
-    ReplayApp(rec, station, speed=args.speed).run()
-    return 0
+    replay = ReplayApp(rec, station, speed=args.speed)
+    replay.run()
+    return closed(replay, "replay")
 
 
 def _verify(args: argparse.Namespace, rec: Recording, station: Station) -> int:

@@ -19,6 +19,7 @@ from textual.message import Message
 from textual.scroll_view import ScrollView
 from textual.strip import Strip
 
+from .guard import Guarded
 from .layout import MAX_ZOOM, Layout, Ref, build_layout
 from .paint import S_CURSOR, Frame, add_overlays, glyph, read_frame
 
@@ -28,7 +29,7 @@ if TYPE_CHECKING:
 CLICKABLE = ("button", "turnout", "signal", "section", "platform")
 
 
-class Diagram(ScrollView, can_focus=True):
+class Diagram(Guarded, ScrollView, can_focus=True):
     DEFAULT_CSS = """
     Diagram {
         background: #101418;

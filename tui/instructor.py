@@ -19,13 +19,15 @@ from textual.widgets import Button, Input, Label, Select, Static
 from liansuo.circuits.faults import KINDS
 
 from .completion import fault_targets
+from .guard import Guarded
 from .layout import Ref
+from .plain import plain
 
 if TYPE_CHECKING:
     from liansuo.simulation.sim import Simulation
 
 
-class InstructorPanel(VerticalScroll):
+class InstructorPanel(Guarded, VerticalScroll):
     DEFAULT_CSS = """
     InstructorPanel { width: 46; dock: right; background: #1a1520; border-left: solid #a070d0; padding: 0 1;
         display: none; scrollbar-size: 1 1; }
@@ -55,6 +57,12 @@ class InstructorPanel(VerticalScroll):
         self._sim_of = sim_of
         self.exercises = exercises
         self.picking = False
+        # the panels the console writes to from outside (its clock, the recorder, an exercise): made here, so they
+        # take their text whether or not the panel has finished composing
+        self.fault_help = Static("", id="fault-help")
+        self.fault_list = Static("no active faults", id="fault-list")
+        self.ex_goal = Static("", id="ex-goal")
+        self.rec_status = Static("", id="rec-status")
 
     @property
     def sim(self) -> Simulation:
@@ -72,8 +80,8 @@ class InstructorPanel(VerticalScroll):
             yield Button("注入 Inject", id="fault-inject", compact=True, variant="error")
             yield Button("修复 Repair", id="fault-repair", compact=True, variant="success")
             yield Button("Pick", id="fault-pick", compact=True)
-        yield Static("", id="fault-help")
-        yield Static("no active faults", id="fault-list")
+        yield self.fault_help
+        yield self.fault_list
         yield Label("现场 Field (switch K)", classes="title")
         yield Select([(s, s) for s in st.sections], prompt="section", id="field-section", compact=True)
         with Horizontal():
@@ -92,10 +100,11 @@ class InstructorPanel(VerticalScroll):
             yield Button("Drive", id="train-drive", compact=True)
             yield Button("Stop", id="train-stop", compact=True)
         yield Label("练习 Exercise", classes="title")
-        yield Select([(p.stem, str(p)) for p in self.exercises], prompt="exercise", id="ex-file", compact=True)
+        yield Select([(plain(p.stem), str(p)) for p in self.exercises], prompt="exercise", id="ex-file",
+                     compact=True)
         yield Button("Load", id="ex-load", compact=True)
-        yield Static("", id="ex-goal")
-        yield Static("", id="rec-status")
+        yield self.ex_goal
+        yield self.rec_status
 
     def on_mount(self) -> None:
         self._describe_kind("broken-rail")
@@ -108,7 +117,8 @@ class InstructorPanel(VerticalScroll):
         if k is None:
             return
         params = ", ".join(f"{p}={v:g}" if isinstance(v, float) else f"{p}={v or '?'}" for p, v in k.params.items())
-        self.query_one("#fault-help", Static).update(f"{k.summary}" + (f"\nparameters: {params}" if params else ""))
+        text = f"{k.summary}" + (f"\nparameters: {params}" if params else "")
+        self.fault_help.update(plain(text))
 
     # ---- events ----
     def on_select_changed(self, event: Select.Changed) -> None:
@@ -192,15 +202,15 @@ class InstructorPanel(VerticalScroll):
     def show_faults(self, sim: Simulation) -> None:
         active = [f.describe() for f in sim.field.faults.values()]
         text = "active: " + "; ".join(active) if active else "no active faults"
-        w = self.query_one("#fault-list", Static)
-        if str(w.content) != text:
-            w.update(text)
+        shown = plain(text)
+        if str(self.fault_list.content) != str(shown):
+            self.fault_list.update(shown)
 
     def show_goal(self, text: str) -> None:
-        self.query_one("#ex-goal", Static).update(text)
+        self.ex_goal.update(plain(text))
 
     def show_recording(self, text: str) -> None:
-        self.query_one("#rec-status", Static).update(text)
+        self.rec_status.update(plain(text))
 
 
 def default_params(sim: Simulation, kind: str, target: str, params: str = "") -> str:

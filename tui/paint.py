@@ -15,6 +15,8 @@ from typing import TYPE_CHECKING
 
 from rich.style import Style
 
+from liansuo.stations.printable import printable
+
 from .layout import Glyph, Layout, Ref
 
 if TYPE_CHECKING:
@@ -105,7 +107,8 @@ def add_overlays(frame: Frame, sim: Simulation, lay: Layout) -> None:
             continue
         run = _longest_run(cells)
         arrow = ">" if tv.direction == "down" else "<"
-        text = f"{tv.name}{arrow}" if tv.direction == "down" else f"{arrow}{tv.name}"
+        name = printable(tv.name)
+        text = f"{name}{arrow}" if tv.direction == "down" else f"{arrow}{name}"
         text = text[: len(run)] if len(run) < len(text) else text
         start = (len(run) - len(text)) // 2
         for i, ch in enumerate(text):

@@ -1,4 +1,8 @@
-"""The console's panels: status line, alarms, event log, function buttons, answer line and command bar."""
+"""The console's panels: status line, alarms, event log, function buttons, answer line and command bar.
+
+Text that may come from a file (ids, names, messages quoting them) reaches the screen through these panels with its
+control characters written out (:func:`~stations.printable.printable`) and never as markup.
+"""
 
 from __future__ import annotations
 
@@ -14,7 +18,10 @@ from textual.suggester import Suggester
 from textual.widget import Widget
 from textual.widgets import Input, RichLog, Static
 
+from liansuo.stations.printable import printable
+
 from .completion import candidates, complete
+from .guard import Guarded
 from .operate import MODES
 
 if TYPE_CHECKING:
@@ -28,7 +35,7 @@ def clock_text(t: float) -> str:
     return f"{int(h):02d}:{int(m):02d}:{s:04.1f}"
 
 
-class StatusBar(Static):
+class StatusBar(Guarded, Static):
     DEFAULT_CSS = """
     StatusBar { height: 1; background: #1d3557; color: #f1faee; }
     """
@@ -49,7 +56,7 @@ def read_alarms(sim: Simulation, acknowledged: set[str]) -> list[AlarmLine]:
     return out
 
 
-class AlarmPanel(Widget):
+class AlarmPanel(Guarded, Widget):
     """Active alarms; an unacknowledged one is red and blinks. Click one (or press ``a``) to acknowledge."""
 
     DEFAULT_CSS = """
@@ -81,10 +88,11 @@ class AlarmPanel(Widget):
             if i:
                 out.append("\n")
             when = f"{a.t:7.1f} " if a.t is not None else "        "
+            text = printable(a.text)
             if a.acknowledged:
-                out.append(when + a.text, style="#c08080")
+                out.append(when + text, style="#c08080")
             else:
-                out.append(when + a.text, style="bold #ff4040" if self.flash else "bold #ffb0b0")
+                out.append(when + text, style="bold #ff4040" if self.flash else "bold #ffb0b0")
         return out
 
     def on_click(self, event: events.Click) -> None:
@@ -93,7 +101,7 @@ class AlarmPanel(Widget):
             self.post_message(self.Acknowledge(self.lines[i].key))
 
 
-class EventLog(RichLog):
+class EventLog(Guarded, RichLog):
     """Events of the interlocking and the world, and every command sent from the console with its answer."""
 
     DEFAULT_CSS = """
@@ -106,6 +114,7 @@ class EventLog(RichLog):
         self.lines_text: list[str] = []
 
     def add(self, text: str, style: str = "") -> None:
+        text = printable(text)
         self.lines_text.append(text)
         if len(self.lines_text) > 4000:
             del self.lines_text[:2000]
@@ -138,7 +147,7 @@ class EventReader:
         return [(e.t, e.kind, e.text) for e in fresh]
 
 
-class FunctionBar(Widget):
+class FunctionBar(Guarded, Widget):
     """The function buttons of the console (总取消, 总人解, ...): click one, then the element it acts on."""
 
     DEFAULT_CSS = """
@@ -194,7 +203,7 @@ class FunctionBar(Widget):
                 self.post_message(self.Selected(name))
 
 
-class MessageLine(Static):
+class MessageLine(Guarded, Static):
     DEFAULT_CSS = """
     MessageLine { height: 1; background: #15181c; }
     """
@@ -202,7 +211,7 @@ class MessageLine(Static):
     def say(self, text: str, ok: bool | None = None) -> None:
         style = "#e0e0e0" if ok is None else "bold #40e070" if ok else "bold #ff5050"
         mark = "" if ok is None else "✓ " if ok else "✗ "
-        self.update(Text(mark + text, style=style, no_wrap=True, overflow="ellipsis"))
+        self.update(Text(mark + printable(text), style=style, no_wrap=True, overflow="ellipsis"))
 
 
 class CommandSuggester(Suggester):
@@ -221,7 +230,7 @@ class CommandSuggester(Suggester):
         return (f"{head} " if head else "") + hits[0]
 
 
-class CommandBar(Input):
+class CommandBar(Guarded, Input):
     """The command line (focus it with ``:``): any command of the command language, Tab completes ids, Up/Down
     walk the history, Enter sends, Esc goes back to the diagram."""
 

@@ -70,9 +70,10 @@ class ReplayApp(ConsoleApp):
     def seek(self, t: float) -> None:
         try:
             self._seek(t)
-        except Exception as exc:  # no traceback on the screen
+        except Exception as exc:  # no traceback on the screen: in the alarms, and on stderr when the console closes
             self.paused = True
-            self.say(f"replay stopped: {type(exc).__name__}: {exc}", False)
+            incident = self.report_unexpected(exc, "seeking")
+            self.say(f"replay stopped: {incident.summary}", False)
 
     def _seek(self, t: float) -> None:
         t = max(0.0, min(t, self.rec.duration))
@@ -118,7 +119,8 @@ class ReplayApp(ConsoleApp):
     def status_text(self, alarms: int) -> Text:
         out = Text(no_wrap=True, overflow="ellipsis")
         out.append(" REPLAY ", style="bold black on #ffd700")
-        out.append(f" {self.sim.station.model.name.zh} │ t {clock_text(self.sim.t)} / {clock_text(self.rec.duration)} ")
+        out.append(printable(f" {self.sim.station.model.name.zh} ") +
+                   f"│ t {clock_text(self.sim.t)} / {clock_text(self.rec.duration)} ")
         out.append("⏸ " if self.paused else "▶ ", style="bold #ffd700" if self.paused else "#80ff80")
         out.append(f"{self.speed:g}x ")
         if alarms:

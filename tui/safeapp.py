@@ -1,0 +1,106 @@
+"""The shell that keeps a console up whatever it is sent: the app under the operator console and the replay.
+
+- An error that escapes one of the console's handlers (:mod:`tui.guard`) becomes an incident (:mod:`tui.incidents`),
+  shown by the console (:meth:`SafeApp.show_incident`); the console carries on.
+- An error Textual cannot recover from ends the console as a crash: the same report, exit status 1.
+- A dialog answered twice in one burst of input cannot close the console's own screen; the command palette
+  (:mod:`tui.palette`) is closed as safely.
+- Every way out asks first: ctrl+q, the command palette's Quit, ``quit`` in the command bar.
+"""
+
+from __future__ import annotations
+
+from textual.app import App
+from textual.await_complete import AwaitComplete
+from textual.command import CommandPalette
+from textual.screen import Screen
+from textual.theme import ThemeProvider
+
+from .dialogs import QuitScreen
+from .guard import Guarded
+from .incidents import Incident, Incidents
+from .palette import ConsolePalette
+
+
+class ConsoleScreen(Guarded, Screen[None]):
+    """The console's main screen: an error in its handlers is reported, not fatal."""
+
+
+class SafeApp(Guarded, App[None]):
+    def __init__(self) -> None:
+        super().__init__()
+        self.incidents = Incidents()
+
+    # ---- what the console fills in ----
+    def sim_time(self) -> float | None:
+        """The simulated time an incident is stamped with."""
+        return None
+
+    def show_incident(self, incident: Incident, where: str) -> None:
+        """Show a new incident to the operator (the answer line, the alarm panel)."""
+
+    def quit_question(self) -> str:
+        return "Quit?"
+
+    def quit_declined(self) -> None:
+        """The operator answered no."""
+
+    # ---- errors ----
+    def get_default_screen(self) -> Screen[None]:
+        return ConsoleScreen(id="_default")
+
+    def report_unexpected(self, error: BaseException, where: str) -> Incident:
+        """An error escaped a handler (:mod:`tui.guard`): keep it for the report and show it."""
+        incident = self.incidents.record(error, where, self._time())
+        try:
+            self.show_incident(incident, where)
+        except Exception as again:  # showing it failed as well: the report after exit has both
+            self.incidents.record(again, "showing an internal error", self._time())
+        return incident
+
+    def _time(self) -> float | None:
+        try:
+            return self.sim_time()
+        except Exception:  # not built yet: the incident has no simulated time
+            return None
+
+    def _handle_exception(self, error: Exception) -> None:
+        """Textual's last resort, for an error outside any guarded handler: the console ends as a crash, with the
+        incident report and exit status 1 (``liansuo tui`` prints it), never quietly."""
+        self.incidents.record(error, "the console's event loop", self._time())
+        self.incidents.crashed = True
+        super()._handle_exception(error)
+
+    def _fatal_error(self) -> None:
+        # Textual would print its own traceback with every local variable in it; the incident report has the
+        # traceback, printed by the command after the terminal is restored
+        self.bell()
+        self._close_messages_no_wait()
+
+    def pop_screen(self) -> AwaitComplete:
+        """Two clicks outside the command palette in one burst close it twice; with only the console's own screen
+        left, the second has nothing to close (Textual would raise ScreenStackError)."""
+        if len(self.screen_stack) <= 1:
+            return AwaitComplete()  # awaits nothing
+        return super().pop_screen()
+
+    # ---- the command palette: the console's own, for commands and for themes ----
+    def action_command_palette(self) -> None:
+        if self.use_command_palette and not any(isinstance(s, CommandPalette) for s in self.screen_stack):
+            self.push_screen(ConsolePalette(id="--command-palette"))
+
+    def search_themes(self) -> None:
+        self.push_screen(ConsolePalette(providers=[ThemeProvider], placeholder="Search for themes…"))
+
+    # ---- the way out ----
+    async def action_quit(self) -> None:
+        """ctrl+q, the palette's Quit and ``quit`` all come here: ask, once."""
+        if any(isinstance(s, QuitScreen) for s in self.screen_stack):
+            return
+        self.push_screen(QuitScreen(self.quit_question()), self._quit_answered)
+
+    def _quit_answered(self, yes: bool | None) -> None:
+        if yes:
+            self.exit()
+        else:
+            self.quit_declined()
