@@ -50,7 +50,8 @@ EXTREMES: tuple[Any, ...] = (float("nan"), float("inf"), float("-inf"), -1, 0, 1
                              10**30, 1e9, 345_601, "", "x" * 5000, "\x1b[2J\x1b]0;owned\x07", "\u2028", "\x00", None,
                              True, [], {}, [[[]]], {"k": "cmd"})
 STATIONS = ("gaotie", "depot", "jiaopei", "/dev/zero", "/tmp", "../nowhere.yaml", "", "x" * 5000, "\x1b[2J", ".")
-COMMAND_LINES = ("run 100h", "run 50min", "run 1s", "", "expect alarm nothing", "route X XI", "cancel X", "bogus", "run 0s")
+COMMAND_LINES = ("run 100h", "run 50min", "run 1s", "", "expect alarm nothing", "route X XI", "cancel X", "bogus",
+                 "run 0s")
 
 
 # ---- seeds ----------------------------------------------------------------------------------------------------------

@@ -221,7 +221,7 @@ async def test_run_1h_advances_in_slices_shows_its_progress_and_esc_stops_it(mon
     app = ConsoleApp("jiaopei", paused=True)
     async with app.run_test(size=SIZE) as pilot:
         t0 = app.sim.t
-        await pilot.press("colon", *"run 1h", "enter")  # before: the console froze until the hour was run (the longest run the language takes)
+        await pilot.press("colon", *"run 1h", "enter")  # before: the console froze until it was run
         assert t0 < app.sim.t < t0 + 3600
         assert "run 1h" in str(app.status_bar.content) and "Esc stops it" in shown(app)
         await pilot.press(*"route X XI")  # the screen answers while the run goes on
