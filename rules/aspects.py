@@ -21,7 +21,7 @@ Aspect = Annotated[str, Field(min_length=1)]
 class Aspects(BaseModel):
     """Every aspect a rule set knows, with what it lights and what it means."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)  # every number finite
 
     colours: dict[str, str]  # lamp -> colour, in the order the lamps stand on the mast from the joint outwards
     stop: Aspect  # a train signal at stop

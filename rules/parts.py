@@ -19,7 +19,7 @@ Metres = Annotated[float, Field(gt=0)]
 
 
 class Part(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)  # every number finite
 
 
 class ApproachLocking(Part):

@@ -23,6 +23,7 @@ from typing import TYPE_CHECKING, Any
 
 from liansuo.circuits.faults import KINDS
 from liansuo.interlocking.table import InterlockingTable, build_table
+from liansuo.rules import load_rules
 from liansuo.stations.loader import load
 from liansuo.stations.source import StationError, read_text, read_yaml
 from liansuo.stations.station import Station
@@ -50,10 +51,11 @@ DURATIONS = ("0", "0s", "250ms", "30s", "3min", "1h", "3600s", "3601s", "168h", 
 KEYWORDS = ("normal", "reverse", "request", "accept", "cancel", "restore", "accident", "depart", "block", "out", "in",
             "open", "close", "remove", "at", "clear", "locked", "free", "occupied", "released", "setting", "signal",
             "route", "turnout", "section", "refused", "accepted", "alarm", "no-alarm", "block-line", "code", "cab",
-            "odometry", "within", "team", "cab", "remote", "system", "on", "off", "ok", "fault", "L", "U", "H", "UU",
-            "USU", "HB", "B", "A", "none", "lost", "wrong-carrier", "left", "right", "main", "backup", "both",
+            "odometry", "within", "team", "cab", "remote", "system", "on", "off", "ok", "fault", "none", "lost",
+            "wrong-carrier", "left", "right", "main", "backup", "both",
             "open", "half", "short", "bad-contact", "freight", "emu", "shunter", "trolley", "manual", "auto",
-            "down", "up", "train", "shunt", *KINDS)
+            "down", "up", "train", "shunt", *KINDS,
+            *load_rules().aspects.lamps)  # the aspect codes, from the rule set (only it names them)
 PARAMETERS = ("kind", "length", "axles", "vmax", "mode", "dir", "movement", "back", "front", "stop", "plan",
               "onboard", "centre", "loco", "perception", "by", *{p for k in KINDS.values() for p in k.params})
 ODD = ("", "''", '"', "'", "#", "# comment", "\\", "=", "==", "a=b=c", "X" * 5000, "\x1b[2J", "\x1b]0;title\x07",
@@ -150,7 +152,7 @@ def _slots(station: str) -> dict[str, tuple[str, ...]]:
     doors = tuple(f"{p.id}:{d.side.value}" for p in m.platforms for d in p.screen_doors)
     out = {"SIG": (*st.signals, *st.buttons), "SEC": tuple(st.sections), "TO": (*st.turnouts, *st.pairs),
            "TRACK": tuple(st.tracks), "JOINT": tuple(st.joints), "PLAT": (*(p.id for p in m.platforms), *doors),
-           "LINK": tuple(lk.id for lk in m.links), "ROUTE": tuple(list(table.routes)[:60]), "NAME": ("T1", "T2", "A"),
+           "LINK": tuple(lk.id for lk in m.links), "ROUTE": tuple(list(table.routes)[:60]), "NAME": ("T1", "T2", "T9"),
            "BUTTONS": tuple(" ".join(r.buttons) for r in list(table.routes.values())[:60])}
     return {k: (*v, "NOPE") for k, v in out.items()}
 

@@ -27,6 +27,7 @@ from typing import Any
 import yaml
 from hypothesis import strategies as st
 
+from liansuo.rules import load_rules
 from liansuo.stations.source import StationError
 
 from .recording import Recorder
@@ -204,8 +205,8 @@ def _plausible(draw: DrawFn, lines: list[bytes]) -> list[bytes]:
         if isinstance(value, bool):
             holder[last] = not value
         elif isinstance(value, str) or value is None:
-            holder[last] = draw(st.sampled_from(("U", "L", "H", "B", "locked", "free", "occupied", "normal",
-                                                 "reverse", None, "route X XI", "cancel X")))
+            holder[last] = draw(st.sampled_from((*load_rules().aspects.lamps, "locked", "free", "occupied",
+                                                 "normal", "reverse", None, "route X XI", "cancel X")))
         elif isinstance(value, int | float):
             holder[last] = value + draw(st.sampled_from((-1, 1)))
     out = list(lines)

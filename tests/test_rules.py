@@ -96,3 +96,13 @@ def test_no_aspect_or_lamp_code_outside_the_rule_set_and_the_aspect_selection() 
                 if isinstance(node, ast.Constant) and node.value in codes and id(node) not in pieces:
                     found.append(f"{path.relative_to(ROOT)}:{node.lineno}: {node.value!r}")
     assert not found, "name these by their role in the rule set:\n" + "\n".join(found)
+
+
+def test_a_number_that_is_not_finite_is_refused_in_every_rule_file(folder: Path) -> None:
+    """NaN or infinity in a rule set would reach every timer and distance it sets (issue 17: every number finite)."""
+    edit(folder / "interlocking.yaml", "overlap_release_s: 180", "overlap_release_s: .nan")
+    edit(folder / "driving.yaml", "stop_margin_m: 8", "stop_margin_m: .inf")
+    with pytest.raises(RuleError) as exc:
+        load_rules(str(folder))
+    text = str(exc.value)
+    assert "interlocking.yaml:8:" in text and "driving.yaml:" in text and text.count("finite number") >= 2, text
