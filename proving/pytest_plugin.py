@@ -19,6 +19,7 @@ interlocking and the simulation are imported only when a script is collected (te
 
 from __future__ import annotations
 
+import re
 from collections.abc import Iterator
 from fnmatch import fnmatch
 from pathlib import Path
@@ -38,9 +39,21 @@ def pytest_addoption(parser: pytest.Parser) -> None:
                        "the command line)")
 
 
+_TESTS_KEY = re.compile(rb"tests\s*:")
+_LOOK_BYTES = 16 * 1024 * 1024  # the input limit of every liansuo file (rules/inputlimits.py)
+
+
 def is_script(path: Path) -> bool:
     """A YAML mapping with ``station:`` and a ``tests:`` list (read within the input limits, as every liansuo file
     is; errors mean 'not a script')."""
+    if not path.is_file():  # a regular file only: a pipe would be waited on
+        return False
+    try:  # a first look without the loader, so a run that collects no script stays light: a script says 'tests:'
+        with path.open("rb") as fh:
+            if not _TESTS_KEY.search(fh.read(_LOOK_BYTES)):
+                return False
+    except OSError:
+        return False
     from liansuo.stations.source import StationError, read_text, read_yaml
 
     try:
