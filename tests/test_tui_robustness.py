@@ -123,6 +123,15 @@ async def test_keys_typed_while_the_console_closes_are_let_go() -> None:
 
 
 @run
+async def test_a_screenshot_due_after_the_console_closed_is_let_go(tmp_path: Path) -> None:
+    app = ConsoleApp("jiaopei", paused=True)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.press("ctrl+q", "y")
+    # the palette's Screenshot fires 0.1 s after it is chosen; quitting at once left it no screen (ScreenStackError)
+    assert app.deliver_screenshot(path=str(tmp_path)) is None and list(tmp_path.iterdir()) == []
+
+
+@run
 async def test_shrinking_the_window_through_1x1_with_a_dialog_or_the_palette_open() -> None:
     for opener in ("P", "ctrl+p", "question_mark"):  # a confirmation, the command palette, help
         app = ConsoleApp("jiaopei", paused=True)

@@ -92,6 +92,14 @@ class SafeApp(Guarded, App[None]):
     def search_themes(self) -> None:
         self.push_screen(ConsolePalette(providers=[ThemeProvider], placeholder="Search for themes…"))
 
+    def deliver_screenshot(self, filename: str | None = None, path: str | None = None,
+                           time_format: str | None = None) -> str | None:
+        """The palette's Screenshot is taken 0.1 s after it is chosen: if the console has closed meanwhile, there is
+        no screen left to take (Textual would raise ScreenStackError while closing)."""
+        if not self.screen_stack:
+            return None
+        return super().deliver_screenshot(filename, path, time_format)
+
     # ---- the way out ----
     async def action_quit(self) -> None:
         """ctrl+q, the palette's Quit and ``quit`` all come here: ask, once."""
