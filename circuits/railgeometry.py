@@ -36,7 +36,9 @@ class Shunt:
 
 class RailGeometry:
     def __init__(self, station: Station) -> None:
-        self.station = station
+        # The tracks, not the station: this object is the value of a cache weakly keyed by the station, and a value
+        # that held its key would keep every station ever simulated alive.
+        self.tracks = station.tracks
         self.track_span = {t: station.track_span(t) for t in station.tracks}
         self.section_low: dict[str, float] = {}
         self.section_length: dict[str, float] = {}
@@ -57,7 +59,7 @@ class RailGeometry:
     def shunts_of(self, axles: list[Axle]) -> dict[str, list[tuple[float, float]]]:
         """The shunts of many wheelsets, by section: the same as ``shunt`` for each, without the call per axle."""
         out: dict[str, list[tuple[float, float]]] = {}
-        span, dead, tracks = self.track_span, self.track_dead, self.station.tracks
+        span, dead, tracks = self.track_span, self.track_dead, self.tracks
         low, length = self.section_low, self.section_length
         for a in axles:
             lo, hi = span[a.track]
@@ -81,11 +83,11 @@ class RailGeometry:
         """The shunt this wheelset makes, or None in a dead zone (or off its track); at distance NaN if its position
         is not a finite number (it shunts its section somewhere unknown)."""
         if not math.isfinite(axle.x):
-            return Shunt(self.station.tracks[axle.track].section, math.nan, axle.ohm)
+            return Shunt(self.tracks[axle.track].section, math.nan, axle.ohm)
         lo, hi = self.track_span[axle.track]
         if not lo - 1e-6 <= axle.x <= hi + 1e-6 or self.in_dead_zone(axle.track, axle.x):
             return None
-        sec = self.station.tracks[axle.track].section
+        sec = self.tracks[axle.track].section
         d = min(max(axle.x - self.section_low[sec], 0.0), self.section_length[sec])
         return Shunt(sec, d, axle.ohm)
 

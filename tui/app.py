@@ -64,6 +64,9 @@ def who(source: str) -> str:
 
 class ConsoleApp(SafeApp):
     TITLE = "liansuo 联锁"
+    # No text selection with the mouse, as on a CBI display: a press is always an operation. (Textual's selection also
+    # kept the widget under a press and failed when a burst of input removed it before the release.)
+    ALLOW_SELECT = False
     # Text too long for its widget ends in an ellipsis instead of folding: Textual cannot fold a word into a width of
     # 0, so a window squeezed through 1x1 with a dialog or the palette open would fail to lay out.
     CSS = """
