@@ -19,6 +19,7 @@ from liansuo.interlocking import cli as interlocking
 from liansuo.proving import cli as proving
 from liansuo.proving import mutation, soakcli
 from liansuo.proving.verify import cli as verify
+from liansuo.server import cli as server
 from liansuo.stations import cli as stations
 from liansuo.stations.jsonreport import version
 from liansuo.tui import cli as tui
@@ -43,6 +44,7 @@ REGISTER: tuple[Callable[[Add], None], ...] = (
     bench.register,  # bench
     tui.register,  # tui
     tui.register_replay,  # replay
+    server.register,  # serve
 )
 
 

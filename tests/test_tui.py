@@ -145,7 +145,7 @@ async def test_manual_release_asks_for_confirmation_and_counts_down_on_the_signa
     async with app.run_test(size=SIZE) as pilot:
         app.send("route X XI")
         cycles(app, 8)
-        app.send("occupy IAG")  # a train approaching: approach locking
+        app.send("occupy IAG", "instructor")  # a train approaching: approach locking
         cycles(app, 2)
         await pilot.press("r")  # the 总人解 key arms the function
         await click(pilot, Ref("signal", "X"))
@@ -383,19 +383,19 @@ async def test_after_a_restart_the_sealed_power_up_release_button_asks_counts_an
 ) -> None:
     app = ConsoleApp("jiaopei", paused=True)
     async with app.run_test(size=SIZE) as pilot:
-        await pilot.press("colon", *"restart", "enter")
+        app.send("restart", "instructor")  # the interlocking's restart is the instructor's (the maintainer's)
         cycles(app, 2)
         assert app.sim.section_state("7DG") == "locked" and app.sim.section_state("IG") == "locked"
         await click(pilot, Ref("button", "X", "train"))
         await click(pilot, Ref("button", "XI", "train"))
         assert "上电锁闭" in message(app)  # the route is refused while the station is power-up locked
-        app.send("occupy 3G")
+        app.send("occupy 3G", "instructor")
         await function(pilot, "power-up")  # the sealed button acts on the whole station: it asks at once
         assert isinstance(app.screen, ConfirmScreen) and "counter 1" in app.screen.question
         await pilot.press("y")
         await pilot.pause()
         assert "3G" in message(app) and app.sim.section_state("7DG") == "locked"  # refused: a section occupied
-        app.send("vacate 3G")
+        app.send("vacate 3G", "instructor")
         cycles(app, 2)
         await pilot.press("P")  # its key, a second use: the counter goes on
         assert isinstance(app.screen, ConfirmScreen) and "counter 2" in app.screen.question
@@ -406,3 +406,21 @@ async def test_after_a_restart_the_sealed_power_up_release_button_asks_counts_an
         await click(pilot, Ref("button", "XI", "train"))
         cycles(app, 40)
         assert app.sim.aspect("X") == "U"
+
+
+@run
+async def test_the_trainees_command_bar_refuses_the_instructors_commands_and_hides_their_faults() -> None:
+    app = ConsoleApp("jiaopei", paused=True, exercise="jiaopei-broken-rail-IG")
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        assert app.sim.section_state("IG") == "occupied"  # the exercise's broken rail is in
+        for line in ("faults", "repair broken-rail IG", "fault filament X", "train T1 at IAG", "occupy 3G"):
+            await pilot.press("colon", *line, "enter")
+            assert "belongs to the instructor" in message(app) and "F2" in message(app), line
+        assert app.sim.section_state("IG") == "occupied" and app.sim.section_state("3G") == "free"
+        cycles(app, 4)
+        log = "\n".join(app.log_panel.lines_text)
+        assert "fault injected" not in log and "fault broken-rail" not in log, log  # the set-up lines stay hidden
+        await pilot.press("f2")  # no password set: the instructor's panel opens, and their commands go through
+        await pilot.press("colon", *"faults", "enter")
+        assert "broken-rail" in message(app)

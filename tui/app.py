@@ -24,7 +24,9 @@ from textual.widgets import Footer
 
 from liansuo.simulation import Result
 from liansuo.simulation.exercise import Exercise, GoalCheck, bundled_exercises, check_goal, parse_exercise
+from liansuo.simulation.passwords import ENV, hash_password, matches
 from liansuo.simulation.recording import FileRecorder
+from liansuo.simulation.roles import INSTRUCTOR, TRAINEE, command_word, refusal
 from liansuo.simulation.sim import Simulation
 from liansuo.stations.printable import printable
 from liansuo.stations.source import StationError
@@ -53,7 +55,7 @@ from .safeapp import SafeApp
 SPEEDS = (0.25, 0.5, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0, 64.0)
 TICK_S = 0.125  # redraw at 8 Hz: often enough for the USU flash (35 per minute)
 MAX_STEPS_PER_TICK = 400
-PASSWORD_ENV = "LIANSUO_INSTRUCTOR_PASSWORD"
+PASSWORD_ENV = ENV  # the instructor password, in the environment
 QUIT_WORDS = ("quit", "exit")  # typed in the command bar, they close the console (after asking), as ctrl+q does
 
 
@@ -94,15 +96,19 @@ class ConsoleApp(SafeApp):
     ]
 
     def __init__(self, station: str = "jiaopei", *, paused: bool = False, speed: float = 1.0,
-                 instructor_password: str | None = None, record: str | Path | None = None,
-                 exercise: str | Path | None = None, cycle_s: float = 0.25, sim: Simulation | None = None) -> None:
+                 instructor_password: str | None = None, instructor_hash: str | None = None,
+                 record: str | Path | None = None, exercise: str | Path | None = None, cycle_s: float = 0.25,
+                 sim: Simulation | None = None) -> None:
         super().__init__()
         self.station_ref = station
         self.sim = sim if sim is not None else Simulation(station, cycle_s=cycle_s)
         self.operator = Operator(self.sim)
         self.paused = paused
         self.speed = speed
-        self.password = instructor_password if instructor_password is not None else os.environ.get(PASSWORD_ENV)
+        # the instructor's password, kept hashed: given as a hash (a password file), as a password, or in the
+        # environment; None opens instructor mode without one
+        plain = instructor_password if instructor_password is not None else os.environ.get(PASSWORD_ENV)
+        self.password = instructor_hash or (hash_password(plain) if plain else None)
         self.instructor = False
         self.acknowledged: set[str] = set()
         self.events = EventReader()
@@ -255,7 +261,7 @@ class ConsoleApp(SafeApp):
         sim = self.sim
         self.diagram.update_view()
         log = self.log_panel
-        for t, kind, text in self.events.new(sim):
+        for t, kind, text in self.events.new(sim, INSTRUCTOR if self.instructor else TRAINEE):
             log.add(f"{t:9.2f} {kind:8} {text}", "#ff6060" if kind == "alarm" else "")
         alarms = self.alarm_lines()
         self.alarm_panel.show(alarms, int(sim.t * 2) % 2 == 0)
@@ -307,6 +313,12 @@ class ConsoleApp(SafeApp):
             self.log_panel.add(f"{self.sim.t:9.2f} {'refused':8} {line}: {why}", "#ff8080")
             self.say(why, False)
             return Result.refuse(why)
+        if source == "trainee" and command_word(line) != "run" and (no := refusal(TRAINEE, line)) is not None:
+            # the console's own clock ('run') is the trainee's too; the world around the console is not
+            why = f"{no.message}; the instructor opens their panel with F2"
+            self.log_panel.add(f"{self.sim.t:9.2f} {'refused':8} {line}: {why}", "#ff8080")
+            self.say(why, False)
+            return Result.refuse(why)
         if self.recorder is not None:
             self.recorder.source = source
         try:
@@ -321,6 +333,9 @@ class ConsoleApp(SafeApp):
             self.long_run = None
             incident = self.report_unexpected(exc, f"the command '{line.split()[0]}'")
             result = Result.refuse(f"internal error: {incident.summary}")
+        if source == "exercise" and not self.instructor:  # an exercise's set-up is the instructor's secret
+            self.refresh_views()
+            return result
         log = self.log_panel
         log.add(f"{self.sim.t:9.2f} {who(source):8} {line}", "#9fd3ff" if source == "trainee" else "#d0a0ff")
         if not result.ok:
@@ -466,7 +481,7 @@ class ConsoleApp(SafeApp):
             await self.set_instructor(True)
 
     async def _password_given(self, given: str | None) -> None:
-        if given == self.password:
+        if given and self.password and matches(given, self.password):
             await self.set_instructor(True)
         elif given:
             self.say("wrong instructor password", False)

@@ -38,8 +38,10 @@ def register(add: Add) -> None:
     sp.add_argument("--record", metavar="FILE", help="record the session (JSON lines) for 'liansuo replay'")
     sp.add_argument("--exercise", metavar="FILE",
                     help="load an exercise: a file, or a bundled one by name (jiaopei-broken-rail-IG, ...)")
-    sp.add_argument("--instructor-password", metavar="PW",
-                    help="password for instructor mode (F2); also read from LIANSUO_INSTRUCTOR_PASSWORD")
+    sp.add_argument("--password-file", metavar="FILE",
+                    help="the password for instructor mode (F2): a hash written by 'liansuo serve --hash-password' "
+                         "(or a password); else LIANSUO_INSTRUCTOR_PASSWORD; never on the command line, where ps "
+                         "shows it")
 
 
 def register_replay(add: Add) -> None:
@@ -80,11 +82,19 @@ def cmd_tui(args: argparse.Namespace) -> int:
         if ex.station_ref() not in (args.station, station.id):
             return refuse("tui", f"exercise '{ex.title}' is for station {ex.station}; start the console with "
                           f"'liansuo tui {ex.station} --exercise {args.exercise}'", Exit.USAGE)
+    stored = None
+    if args.password_file:
+        from liansuo.simulation.passwords import PasswordError, instructor_hash
+
+        try:
+            stored = instructor_hash(args.password_file)
+        except PasswordError as exc:
+            return refuse("tui", str(exc), Exit.USAGE)
     from .app import ConsoleApp
 
     try:
         app = ConsoleApp(args.station, paused=args.paused, speed=args.speed, record=args.record,
-                         exercise=args.exercise, instructor_password=args.instructor_password)
+                         exercise=args.exercise, instructor_hash=stored)
     except OSError as exc:
         return refuse("tui", str(exc), Exit.BAD_INPUT)
     app.run()

@@ -6,7 +6,7 @@ control characters written out (:func:`~stations.printable.printable`) and never
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, ClassVar
 
@@ -18,6 +18,7 @@ from textual.suggester import Suggester
 from textual.widget import Widget
 from textual.widgets import Input, RichLog, Static
 
+from liansuo.simulation.snapshot import EventCursor
 from liansuo.stations.printable import printable
 
 from .completion import candidates, complete
@@ -25,7 +26,6 @@ from .guard import Guarded
 from .operate import MODES
 
 if TYPE_CHECKING:
-    from liansuo.interlocking.io import Event
     from liansuo.simulation.sim import Simulation
 
 
@@ -122,29 +122,17 @@ class EventLog(Guarded, RichLog):
 
 
 class EventReader:
-    """Reads new events from the interlocking's and the world's event deques, in time order."""
+    """Reads new events from the interlocking's and the world's event logs, in time order, as ``role`` may see
+    them (a trainee's console leaves out the instructor's faults and trains: :mod:`simulation.roles`)."""
 
     def __init__(self) -> None:
-        self._last: dict[int, object] = {}
+        self._cursor = EventCursor()
 
     def reset(self) -> None:
-        self._last = {}
+        self._cursor = EventCursor()
 
-    def new(self, sim: Simulation) -> list[tuple[float, str, str]]:
-        sources: list[Sequence[Event]] = [sim.view.events(), sim.events]
-        fresh: list[Event] = []
-        for i, dq in enumerate(sources):
-            last = self._last.get(i)
-            got = []
-            for e in reversed(dq):
-                if e is last:
-                    break
-                got.append(e)
-            if dq:
-                self._last[i] = dq[-1]
-            fresh += reversed(got)
-        fresh.sort(key=lambda e: e.t)
-        return [(e.t, e.kind, e.text) for e in fresh]
+    def new(self, sim: Simulation, role: str) -> list[tuple[float, str, str]]:
+        return [(e.t, e.kind, e.text) for e in self._cursor.fresh(sim, role)]
 
 
 class FunctionBar(Guarded, Widget):

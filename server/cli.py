@@ -1,0 +1,82 @@
+"""``liansuo serve``: the classroom server, registered by the command line (``cli/main.py``)."""
+
+from __future__ import annotations
+
+import argparse
+import asyncio
+import getpass
+import sys
+from collections.abc import Callable
+from typing import TYPE_CHECKING
+
+from liansuo.stations.exitcodes import Exit, bad_input, refuse
+from liansuo.stations.source import StationError
+
+if TYPE_CHECKING:
+    from .websocket import ClassroomServer
+
+Handler = Callable[[argparse.Namespace], int]
+Add = Callable[[str, Handler, str], argparse.ArgumentParser]
+
+
+def register(add: Add) -> None:
+    sp = add("serve", cmd_serve, "serve a classroom: one simulation per trainee seat, and the instructor")
+    sp.add_argument("station", nargs="?", default="jiaopei", help="bundled station name or path (default jiaopei)")
+    sp.add_argument("--seats", type=int, default=2, metavar="N", help="trainee seats, 1 to 64 (default 2)")
+    sp.add_argument("--host", default="127.0.0.1",
+                    help="address to listen on (default 127.0.0.1: this machine only; 0.0.0.0 for a classroom)")
+    sp.add_argument("--port", type=int, default=8765, metavar="P", help="port (default 8765; 0 picks a free one)")
+    sp.add_argument("--password-file", metavar="FILE",
+                    help="the instructor's password: a hash written by --hash-password (or a password); without it "
+                         "the environment variable LIANSUO_INSTRUCTOR_PASSWORD")
+    sp.add_argument("--hash-password", action="store_true",
+                    help="read a password on the terminal (or standard input), print its hash for --password-file, "
+                         "and exit")
+
+
+def cmd_serve(args: argparse.Namespace) -> int:
+    from liansuo.simulation.passwords import PasswordError, hash_password, instructor_hash
+
+    if args.hash_password:
+        pw = getpass.getpass("instructor password: ") if sys.stdin.isatty() else sys.stdin.readline().rstrip("\n")
+        if not pw:
+            return refuse("serve", "an empty password protects nothing", Exit.USAGE)
+        print(hash_password(pw))
+        return 0
+    if not 0 <= args.port <= 65535:
+        return refuse("serve", f"--port is 0 to 65535, not {args.port}", Exit.USAGE)
+    try:
+        stored = instructor_hash(args.password_file)
+    except PasswordError as exc:
+        return refuse("serve", str(exc), Exit.USAGE)
+    from .classroom import Classroom, SeatError
+    from .websocket import ClassroomServer
+
+    try:
+        classroom = Classroom(args.station, args.seats)
+    except StationError as exc:
+        return bad_input(exc)
+    except SeatError as exc:
+        return refuse("serve", str(exc), Exit.USAGE)
+    server = ClassroomServer(classroom, stored)
+    try:
+        asyncio.run(_serve(server, args.host, args.port, len(classroom.seats)))
+    except OSError as exc:
+        return refuse("serve", f"cannot listen on {args.host}:{args.port}: {exc.strerror or exc}", Exit.USAGE)
+    except KeyboardInterrupt:
+        pass
+    finally:
+        classroom.close()
+    return 0
+
+
+async def _serve(server: ClassroomServer, host: str, port: int, seats: int) -> None:
+    ready: asyncio.Future[int] = asyncio.get_running_loop().create_future()
+    task = asyncio.create_task(server.serve(host, port, ready))
+    while not ready.done():  # listening, or the task ended: the OSError of a port it could not listen on goes up
+        if task.done():
+            task.result()
+        await asyncio.sleep(0.01)
+    print(f"liansuo serve: {seats} seats of {server.classroom.station_ref} on ws://{host}:{ready.result()} "
+          f"(ctrl+c stops)", flush=True)
+    await task

@@ -1,0 +1,162 @@
+"""The classroom over a websocket: one JSON message a frame, each way (docs/classroom.md, "The protocol").
+
+A client's first message is a ``hello`` naming its role. A trainee gets one seat and its snapshots; the instructor
+(with the password) may watch any seat, send any command to any seat, and run the seats' clocks. The server answers
+every message; one it cannot read gets an ``error`` reply and changes nothing, and a client that disconnects may
+take its seat back with the token it was given.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import json
+import sys
+import time
+import traceback
+from dataclasses import dataclass, field
+from typing import Any
+
+from pydantic import ValidationError
+from websockets.asyncio.server import ServerConnection, serve
+from websockets.exceptions import ConnectionClosed
+
+from liansuo.simulation.passwords import matches
+from liansuo.simulation.roles import INSTRUCTOR, TRAINEE
+from liansuo.simulation.snapshot import EventCursor
+
+from .classroom import Classroom, SeatError
+from .messages import MESSAGE, Clock, Command, Hello, Reset, Watch, problem
+
+TICK_S = 0.05  # the clocks' pace on the wall clock
+PUSH_S = 0.25  # a snapshot to each client this often
+MAX_MESSAGE = 64 * 1024
+HELLO_TIMEOUT_S = 10.0
+
+
+@dataclass
+class Client:
+    role: str
+    seat: int  # the trainee's seat, or the seat the instructor watches
+    token: str = ""
+    cursor: EventCursor = field(default_factory=EventCursor)
+
+
+class ClassroomServer:
+    def __init__(self, classroom: Classroom, instructor_hash: str) -> None:
+        self.classroom = classroom
+        self.instructor_hash = instructor_hash
+        self.errors = 0  # unexpected errors answered and survived (their tracebacks went to stderr)
+
+    # ---- the loop -------------------------------------------------------------------------------------------------
+    async def serve(self, host: str, port: int, ready: asyncio.Future[int] | None = None) -> None:
+        """Serve until cancelled; ``ready`` gets the port listened on (useful with port 0)."""
+        async with serve(self.handle, host, port, max_size=MAX_MESSAGE) as server:
+            bound = next(iter(server.sockets)).getsockname()[1]
+            if ready is not None:
+                ready.set_result(bound)
+            await self.run_clocks()
+
+    async def run_clocks(self) -> None:
+        last = time.monotonic()
+        while True:
+            await asyncio.sleep(TICK_S)
+            now = time.monotonic()
+            self.classroom.advance(now - last)
+            last = now
+
+    async def handle(self, ws: ServerConnection) -> None:
+        client: Client | None = None
+        pusher: asyncio.Task[None] | None = None
+        try:
+            client = await self.greet(ws)
+            if client is None:
+                return
+            pusher = asyncio.create_task(self.push(ws, client))
+            async for raw in ws:
+                await ws.send(json.dumps(self.answer(client, raw)))
+        except ConnectionClosed:
+            pass
+        finally:
+            if pusher is not None:
+                pusher.cancel()
+            if client is not None and client.role == TRAINEE:
+                self.classroom.leave(client.seat, client.token)
+
+    async def greet(self, ws: ServerConnection) -> Client | None:
+        """The first message: who the client is. None (after an error reply, connection closed) when refused."""
+        try:
+            raw = await asyncio.wait_for(ws.recv(), HELLO_TIMEOUT_S)
+            hello = MESSAGE.validate_json(raw)
+            if not isinstance(hello, Hello):
+                raise SeatError("the first message is a hello: {\"type\": \"hello\", \"role\": ...}")
+            client = self.admit(hello)
+        except (TimeoutError, ValidationError, SeatError, ValueError) as exc:
+            why = problem(exc) if isinstance(exc, ValidationError) else str(exc) or "no hello in time"
+            await ws.send(json.dumps({"type": "error", "message": why}))
+            await ws.close(1008, why[:120])
+            return None
+        seat = self.classroom.seat(client.seat)
+        await ws.send(json.dumps({"type": "welcome", "role": client.role, "seat": client.seat, "token": client.token,
+                                  "station": self.classroom.station_source(), "cycle_s": seat.sim.cycle_s,
+                                  "seats": len(self.classroom.seats)}))
+        return client
+
+    def admit(self, hello: Hello) -> Client:
+        if hello.role == INSTRUCTOR:
+            if hello.password is None or not matches(hello.password, self.instructor_hash):
+                raise SeatError("wrong instructor password")
+            return Client(INSTRUCTOR, 1)
+        if hello.seat is None:
+            raise SeatError("a trainee names a seat: {\"seat\": N}")
+        token = self.classroom.take(hello.seat, hello.name, hello.token)
+        return Client(TRAINEE, hello.seat, token)
+
+    async def push(self, ws: ServerConnection, client: Client) -> None:
+        n = 0
+        while True:
+            await ws.send(json.dumps(self.classroom.snapshot(client.seat, client.role, client.cursor)))
+            if client.role == INSTRUCTOR and n % 4 == 0:
+                await ws.send(json.dumps({"type": "seats", "seats": self.classroom.summaries()}))
+            n += 1
+            await asyncio.sleep(PUSH_S)
+
+    # ---- one message --------------------------------------------------------------------------------------------
+    def answer(self, client: Client, raw: str | bytes) -> dict[str, Any]:
+        """The reply to one message; never raises (an unexpected error is answered, and its traceback printed)."""
+        try:
+            msg = MESSAGE.validate_json(raw)
+            return self.dispatch(client, msg)
+        except ValidationError as exc:
+            return {"type": "error", "message": f"cannot read the message: {problem(exc)}"}
+        except SeatError as exc:
+            return {"type": "error", "message": str(exc)}
+        except Exception:  # the server carries on for every other client
+            self.errors += 1
+            traceback.print_exc(file=sys.stderr)
+            return {"type": "error", "message": "internal error on the server (reported in its log)"}
+
+    def dispatch(self, client: Client, msg: Hello | Command | Watch | Clock | Reset) -> dict[str, Any]:
+        instructor = client.role == INSTRUCTOR
+        if isinstance(msg, Hello):
+            raise SeatError("a hello is sent once, first")
+        if isinstance(msg, Command):
+            if msg.seat is not None and msg.seat != client.seat and not instructor:
+                raise SeatError("a trainee operates only their own seat")
+            seat = msg.seat if instructor and msg.seat is not None else client.seat
+            r = self.classroom.command(seat, client.role, msg.line)
+            return {"type": "answer", "id": msg.id, "seat": seat, "ok": r.ok, "message": r.message}
+        if not instructor:
+            raise SeatError(f"'{msg.type}' is the instructor's: a trainee sends commands only")
+        if isinstance(msg, Watch):
+            self.classroom.seat(msg.seat)
+            client.seat, client.cursor = msg.seat, EventCursor()
+            return {"type": "ok", "message": f"watching seat {msg.seat}"}
+        seats = list(self.classroom.seats) if msg.seats == "all" else [int(s) for s in msg.seats]
+        if isinstance(msg, Clock):
+            paused = None if msg.action is None else msg.action == "pause"
+            self.classroom.set_clock(seats, paused=paused, speed=msg.speed)
+            return {"type": "ok", "message": f"clock of seats {', '.join(map(str, seats))}: "
+                                             f"{msg.action or 'speed'} {'' if msg.speed is None else msg.speed}"}
+        self.classroom.reset(seats)
+        client.cursor = EventCursor()
+        return {"type": "ok", "message": f"seats {', '.join(map(str, seats))} reset"}

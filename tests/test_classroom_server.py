@@ -1,0 +1,135 @@
+"""The classroom server end to end: ``liansuo serve`` in its own process, trainees and the instructor as real
+websocket clients (docs/classroom.md). What a trainee's seat receives is read from the wire."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+import time
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+from websockets.sync.client import connect
+
+from liansuo.server.client import ClassroomClient, ClassroomError
+from liansuo.simulation.passwords import hash_password, instructor_hash, matches
+
+PASSWORD = "correct horse"
+
+
+@pytest.fixture(scope="module")
+def url(tmp_path_factory: pytest.TempPathFactory) -> Iterator[str]:
+    secret = tmp_path_factory.mktemp("serve") / "instructor.pw"
+    secret.write_text(hash_password(PASSWORD) + "\n", encoding="utf-8")
+    proc = subprocess.Popen([sys.executable, "-m", "liansuo.cli", "serve", "jiaopei", "--seats", "3", "--port", "0",
+                             "--password-file", str(secret)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True)
+    try:
+        assert proc.stdout is not None
+        line = proc.stdout.readline()
+        assert "ws://127.0.0.1:" in line, line + (proc.stderr.read() if proc.stderr else "")
+        yield line.split(" on ")[1].split()[0]
+    finally:
+        proc.terminate()
+        proc.wait(10)
+
+
+def test_a_trainee_cannot_send_the_instructors_commands(url: str) -> None:
+    with ClassroomClient.trainee(url, seat=2, name="Wang") as wang:
+        for line in ("fault broken-rail IG", "faults", "train T1 at IIAG", "occupy 3DG", "repair broken-rail IG",
+                     "run 10min", "expect section IG free"):
+            answer = wang.command(line)
+            assert not answer["ok"], line
+            assert "instructor" in answer["message"] or "clock" in answer["message"], answer
+        assert wang.command("route X XI")["ok"]
+
+
+def test_an_injected_fault_never_reaches_the_other_seat_nor_the_faulted_trainees_log(url: str) -> None:
+    with ClassroomClient.instructor(url, PASSWORD) as teacher, \
+            ClassroomClient.trainee(url, seat=1, name="Li") as li, ClassroomClient.trainee(url, seat=2) as wang:
+        assert teacher.command("fault broken-rail IG", seat=1)["ok"]
+        time.sleep(1.0)
+        for _ in range(4):
+            li.snapshot()
+            wang.snapshot()
+        assert li.last is not None and wang.last is not None
+        assert li.last["sections"]["IG"][0] is True  # the red band, as the track relay shows it
+        assert wang.last["sections"]["IG"][0] is False  # the other seat's station is untouched
+        for client in (li, wang):
+            seen = json.dumps(client.events)
+            assert "broken" not in seen and "fault" not in seen, seen
+        answer = li.command("fault-release IG")  # an operator's command: the interlocking answers it
+        assert answer["type"] == "answer" and "instructor" not in answer["message"], answer
+        teacher.request({"type": "watch", "seat": 1})
+        teacher.snapshot()
+        assert any("fault injected" in text for _, _, text in teacher.events)
+        assert teacher.command("repair broken-rail IG", seat=1)["ok"]
+
+
+def test_a_seat_is_taken_back_with_its_token_and_by_nobody_else(url: str) -> None:
+    first = ClassroomClient.trainee(url, seat=3, name="Zhao")
+    token = first.token
+    with pytest.raises(ClassroomError, match="seat 3 is taken"):
+        ClassroomClient.trainee(url, seat=3, name="Qian")
+    first.close()
+    time.sleep(0.3)
+    with pytest.raises(ClassroomError, match="belongs to Zhao"):
+        ClassroomClient.trainee(url, seat=3, name="Qian")
+    with pytest.raises(ClassroomError, match="no seat 4"):
+        ClassroomClient.trainee(url, seat=4)
+    with ClassroomClient.trainee(url, seat=3, name="Zhao", token=token) as back:
+        assert back.welcome["seat"] == 3
+        assert back.command("cancel X")["type"] == "answer"
+
+
+def test_bad_messages_get_an_error_reply_and_the_server_carries_on(url: str) -> None:
+    with ClassroomClient.trainee(url, seat=2) as c:
+        for raw in ("{", "[]", '{"type": "command"}', '{"type": "command", "id": -1, "line": "x"}',
+                    '{"type": "clock", "seats": "all", "action": "pause"}', '{"type": "hello", "role": "trainee"}',
+                    json.dumps({"type": "command", "id": 1, "line": "route " + "X" * 5000}), '"\\u0000"'):
+            c.ws.send(raw)
+            reply = _reply(c)
+            assert reply["type"] == "error", (raw, reply)
+        assert c.command("route X XI")["type"] == "answer"
+
+
+def _reply(c: ClassroomClient) -> dict[str, object]:
+    while True:
+        msg = c._next()
+        if msg.get("type") not in ("snapshot", "seats"):
+            return msg
+
+
+def test_the_instructor_needs_the_password_and_runs_the_clocks(url: str) -> None:
+    with pytest.raises(ClassroomError, match="wrong instructor password"):
+        ClassroomClient.instructor(url, "guess")
+    with connect(url) as ws:  # a first message that is not a hello
+        ws.send('{"type": "command", "id": 1, "line": "route X XI"}')
+        assert "hello" in json.loads(ws.recv(timeout=5))["message"]
+    with ClassroomClient.instructor(url, PASSWORD) as teacher:
+        assert teacher.request({"type": "clock", "seats": [2], "action": "pause"})["type"] == "ok"
+        t0 = teacher.request({"type": "watch", "seat": 2}) and teacher.snapshot()["t"]
+        time.sleep(0.6)
+        assert teacher.snapshot()["t"] == t0  # paused
+        assert teacher.request({"type": "clock", "seats": "all", "action": "run", "speed": 4})["type"] == "ok"
+        time.sleep(0.6)
+        assert teacher.snapshot()["t"] > t0
+        assert teacher.request({"type": "clock", "seats": [9], "action": "run"})["type"] == "error"
+        seats = teacher.request({"type": "clock", "seats": "all", "speed": 1.0})
+        assert seats["type"] == "ok"
+
+
+def test_the_password_is_kept_hashed() -> None:
+    stored = hash_password(PASSWORD)
+    assert PASSWORD not in stored and stored.startswith("scrypt$")
+    assert matches(PASSWORD, stored) and not matches("correct horse ", stored) and not matches(PASSWORD, "junk")
+
+
+def test_no_password_means_no_server(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.delenv("LIANSUO_INSTRUCTOR_PASSWORD", raising=False)
+    with pytest.raises(ValueError, match="LIANSUO_INSTRUCTOR_PASSWORD"):
+        instructor_hash(None)
+    with pytest.raises(ValueError, match="cannot read"):
+        instructor_hash(tmp_path / "missing")
