@@ -40,6 +40,7 @@ def register(add: Add) -> None:
                     help="load an exercise: a file, or a bundled one by name (jiaopei-broken-rail-IG, ...)")
     sp.add_argument("--instructor-password", metavar="PW",
                     help="password for instructor mode (F2); also read from LIANSUO_INSTRUCTOR_PASSWORD")
+    sp.add_argument("--mute", action="store_true", help="start with the alarm bell muted (m or 'unmute' turns it on)")
 
 
 def register_replay(add: Add) -> None:
@@ -84,7 +85,7 @@ def cmd_tui(args: argparse.Namespace) -> int:
 
     try:
         app = ConsoleApp(args.station, paused=args.paused, speed=args.speed, record=args.record,
-                         exercise=args.exercise, instructor_password=args.instructor_password)
+                         exercise=args.exercise, instructor_password=args.instructor_password, mute=args.mute)
     except OSError as exc:
         return refuse("tui", str(exc), Exit.BAD_INPUT)
     app.run()
