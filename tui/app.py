@@ -17,10 +17,11 @@ from pathlib import Path
 from typing import ClassVar
 
 from rich.text import Text
+from textual.actions import SkipAction
 from textual.app import ComposeResult
 from textual.binding import Binding, BindingType
 from textual.containers import Horizontal, Vertical
-from textual.widgets import Footer
+from textual.widgets import Footer, Input
 
 from liansuo.simulation import Result
 from liansuo.simulation.exercise import Exercise, GoalCheck, bundled_exercises, check_goal, parse_exercise
@@ -31,6 +32,8 @@ from liansuo.simulation.sim import Simulation
 from liansuo.stations.printable import printable
 from liansuo.stations.source import StationError
 
+from .completion import example_route
+from .describe import describe
 from .diagram import Diagram
 from .dialogs import ConfirmScreen, HelpScreen, MenuScreen, PasswordScreen
 from .incidents import KEY_PREFIX, Incident
@@ -39,6 +42,7 @@ from .layout import Ref
 from .longrun import LongRun, requested_run
 from .operate import MODES, Operator, Outcome
 from .panels import (
+    AlarmBell,
     AlarmLine,
     AlarmPanel,
     CommandBar,
@@ -57,6 +61,7 @@ TICK_S = 0.125  # redraw at 8 Hz: often enough for the USU flash (35 per minute)
 MAX_STEPS_PER_TICK = 400
 PASSWORD_ENV = ENV  # the instructor password, in the environment
 QUIT_WORDS = ("quit", "exit")  # typed in the command bar, they close the console (after asking), as ctrl+q does
+MUTE_WORDS = {"mute": True, "unmute": False}  # typed in the command bar, they mute or unmute the alarm bell, as m does
 
 
 def who(source: str) -> str:
@@ -73,7 +78,7 @@ class ConsoleApp(SafeApp):
     # 0, so a window squeezed through 1x1 with a dialog or the palette open would fail to lay out.
     CSS = """
     * { text-overflow: ellipsis; }
-    Screen { layout: vertical; background: #0c0f12; }
+    ConsoleScreen { layout: vertical; background: #0c0f12; }  /* only the console's own: dialogs let it show */
     #main { height: 1fr; }
     #left { width: 1fr; }
     Diagram { height: 3fr; }
@@ -83,13 +88,14 @@ class ConsoleApp(SafeApp):
     """
 
     BINDINGS: ClassVar[list[BindingType]] = [
-        Binding("colon", "command_bar", "command", key_display=":"),
+        Binding("colon", "command_bar", "command", key_display=":", priority=True),
         Binding("space", "pause", "pause/run", key_display="space"),
         Binding("full_stop", "step", "step", show=False),
         Binding("greater_than_sign", "speed(1)", "faster", show=False),
         Binding("less_than_sign", "speed(-1)", "slower", show=False),
         Binding("escape", "escape", "drop", show=False),
         Binding("a", "acknowledge", "ack alarms", show=False),
+        Binding("m", "mute", "mute bell", show=False),
         Binding("f1,question_mark", "help", "help", key_display="?"),
         Binding("f2", "instructor", "instructor", key_display="F2"),
         *[Binding(m.key, f"arm('{m.name}')", m.en, show=False) for m in MODES.values()],
@@ -98,7 +104,7 @@ class ConsoleApp(SafeApp):
     def __init__(self, station: str = "jiaopei", *, paused: bool = False, speed: float = 1.0,
                  instructor_password: str | None = None, instructor_hash: str | None = None,
                  record: str | Path | None = None, exercise: str | Path | None = None, cycle_s: float = 0.25,
-                 sim: Simulation | None = None) -> None:
+                 sim: Simulation | None = None, mute: bool = False) -> None:
         super().__init__()
         self.station_ref = station
         self.sim = sim if sim is not None else Simulation(station, cycle_s=cycle_s)
@@ -111,6 +117,7 @@ class ConsoleApp(SafeApp):
         self.password = instructor_hash or (hash_password(plain) if plain else None)
         self.instructor = False
         self.acknowledged: set[str] = set()
+        self.alarm_bell = AlarmBell(mute)
         self.events = EventReader()
         self.exercise: Exercise | None = None
         self.goal: GoalCheck | None = None
@@ -132,7 +139,7 @@ class ConsoleApp(SafeApp):
     def compose(self) -> ComposeResult:
         yield StatusBar(id="status")
         with Horizontal(id="main"), Vertical(id="left"):
-            yield Diagram(lambda: self.sim, self.operator.pressed, id="diagram")
+            yield Diagram(lambda: self.sim, self.operator.pressed, id="diagram", operable=self.operator.operable)
             with Horizontal(id="panels"):
                 yield AlarmPanel(id="alarms")
                 yield EventLog(id="events")
@@ -265,6 +272,8 @@ class ConsoleApp(SafeApp):
             log.add(f"{t:9.2f} {kind:8} {text}", "#ff6060" if kind == "alarm" else "")
         alarms = self.alarm_lines()
         self.alarm_panel.show(alarms, int(sim.t * 2) % 2 == 0)
+        if self.alarm_bell.due(alarms):
+            self.bell()
         if self.exercise is not None and self._ticks % 8 == 0:
             self.check_exercise()
         if self.instructor and self.instructor_panel is not None:
@@ -288,6 +297,8 @@ class ConsoleApp(SafeApp):
         out.append(f"{self.speed:g}x ")
         if alarms:
             out.append(f"│ ⚠ {alarms} alarm{'s' if alarms > 1 else ''} ", style="bold #ff4040")
+        if self.alarm_bell.muted:
+            out.append("│ 🔕 bell muted (m) ", style="#ffd700")
         counting = self.diagram.frame().countdown if self.diagram.layout_ is not None else {}
         if counting:
             out.append("│ 人解 " + " ".join(f"{s} {n}s" for s, n in sorted(counting.items())) + " ", style="#ffd700")
@@ -365,11 +376,18 @@ class ConsoleApp(SafeApp):
         if line.split() and line.split()[0] in QUIT_WORDS and len(line.split()) == 1:
             self.call_later(self.action_quit)
             return
+        if line in MUTE_WORDS:
+            self.set_muted(MUTE_WORDS[line])
+            return
         self.send(line, "instructor" if self.instructor else "trainee")
 
     # ---- operating by buttons ----
     def on_diagram_pressed(self, event: Diagram.Pressed) -> None:
         self.press(event.ref)  # an error here is reported by the guard (tui/guard.py)
+
+    def on_diagram_cursor_moved(self, event: Diagram.CursorMoved) -> None:
+        prompt = self.operator.prompt()
+        self.say(describe(self.sim, event.ref) + (f"  ·  {prompt}" if prompt else ""))
 
     def press(self, ref: Ref) -> None:
         panel = self.instructor_panel
@@ -381,7 +399,7 @@ class ConsoleApp(SafeApp):
     def carry_out(self, out: Outcome) -> None:
         if out.menu is not None:
             kind, element = out.menu
-            self.push_screen(MenuScreen(kind, element, self._menu_title(kind, element)),
+            self.push_screen(MenuScreen(kind, element, self._menu_title(kind, element), self.diagram.cursor_region()),
                              lambda name: self._menu_chosen(kind, element, name))
         elif out.command and out.confirm:
             command = out.command
@@ -392,7 +410,7 @@ class ConsoleApp(SafeApp):
                 else:
                     self.say(f"not sent: {command}")
 
-            self.push_screen(ConfirmScreen(out.confirm), answered)
+            self.push_screen(ConfirmScreen(out.confirm, self.diagram.cursor_region()), answered)
         elif out.command:
             self.send(out.command)
         elif out.message:
@@ -427,7 +445,12 @@ class ConsoleApp(SafeApp):
         self.diagram.update_view()
 
     def action_command_bar(self) -> None:
-        self.command_bar.focus()
+        """':' focuses the bar at once: a priority binding, run before the keys typed after it are passed on, and
+        no ``Widget.focus`` (which waits for them), so every key of a quick ``:route X XI`` goes into the bar and none
+        arms a function button on the diagram. In a dialog or another input ':' is typed as it is."""
+        if self.screen is not self.command_bar.screen or isinstance(self.focused, Input):
+            raise SkipAction()
+        self.command_bar.screen.set_focus(self.command_bar)
 
     def action_escape(self) -> None:
         if self.long_run is not None:
@@ -462,6 +485,14 @@ class ConsoleApp(SafeApp):
         self.incidents.acknowledge()
         self.refresh_views()
 
+    def action_mute(self) -> None:
+        self.set_muted(not self.alarm_bell.muted)
+
+    def set_muted(self, muted: bool) -> None:
+        self.alarm_bell.muted = muted
+        self.say("alarm bell muted (m unmutes)" if muted else "alarm bell on")
+        self.refresh_views()
+
     def on_alarm_panel_acknowledge(self, event: AlarmPanel.Acknowledge) -> None:
         if event.key and event.key.startswith(KEY_PREFIX):
             self.incidents.acknowledge(event.key)
@@ -470,7 +501,7 @@ class ConsoleApp(SafeApp):
         self.refresh_views()
 
     def action_help(self) -> None:
-        self.push_screen(HelpScreen())
+        self.push_screen(HelpScreen(example_route(self.sim)))
 
     async def action_instructor(self) -> None:
         if self.instructor:

@@ -42,6 +42,7 @@ def register(add: Add) -> None:
                     help="the password for instructor mode (F2): a hash written by 'liansuo serve --hash-password' "
                          "(or a password); else LIANSUO_INSTRUCTOR_PASSWORD; never on the command line, where ps "
                          "shows it")
+    sp.add_argument("--mute", action="store_true", help="start with the alarm bell muted (m or 'unmute' turns it on)")
 
 
 def register_replay(add: Add) -> None:
@@ -94,7 +95,7 @@ def cmd_tui(args: argparse.Namespace) -> int:
 
     try:
         app = ConsoleApp(args.station, paused=args.paused, speed=args.speed, record=args.record,
-                         exercise=args.exercise, instructor_hash=stored)
+                         exercise=args.exercise, instructor_hash=stored, mute=args.mute)
     except OSError as exc:
         return refuse("tui", str(exc), Exit.BAD_INPUT)
     app.run()

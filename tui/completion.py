@@ -175,3 +175,16 @@ def complete(sim: Simulation, text: str) -> tuple[str, list[str]]:
         if len(common) > len(partial):
             return prefix + common, hits
     return text, hits
+
+
+def example_route(sim: Simulation) -> str:
+    """A command line for hints and help, in the station's own ids: the train route of its interlocking table with the
+    fewest turnouts reversed (the first such; ``route X XI`` on jiaopei), else such a shunting route (``shunt D1 D7``
+    on the depot)."""
+    routes = list(sim.table.routes.values())
+    kind = "train" if any(r.kind == "train" for r in routes) else "shunt"
+    routes = [r for r in routes if r.kind == kind]
+    if not routes:
+        return "route START END"
+    best = min(routes, key=lambda r: (sum(pos.value == "reverse" for _, pos in r.path.turnouts), len(r.via)))
+    return " ".join(["route" if kind == "train" else "shunt", best.start, *best.via, best.end])

@@ -2,7 +2,8 @@
 
 A Line-API widget (Textual ``ScrollView``): it pans (shift+arrows, mouse wheel, drag with the right button) and
 zooms (``+`` / ``-``; ``0`` fits the window again). Clicks and the keyboard cursor (arrows move it between
-clickable elements, Enter presses) post :class:`Diagram.Pressed` with the element's :class:`~tui.layout.Ref`.
+operable elements by :func:`nearest`, Enter presses) post :class:`Diagram.Pressed` with the element's
+:class:`~tui.layout.Ref`; a move of the cursor posts :class:`Diagram.CursorMoved`.
 """
 
 from __future__ import annotations
@@ -14,7 +15,7 @@ from rich.segment import Segment
 from rich.style import Style
 from textual import events
 from textual.binding import Binding, BindingType
-from textual.geometry import Size
+from textual.geometry import Region, Size
 from textual.message import Message
 from textual.scroll_view import ScrollView
 from textual.strip import Strip
@@ -57,11 +58,19 @@ class Diagram(Guarded, ScrollView, can_focus=True):
             super().__init__()
             self.ref = ref
 
-    def __init__(self, sim_of: Callable[[], Simulation], pressed: Callable[[], set[Ref]], *, id: str | None = None
-                 ) -> None:
+    class CursorMoved(Message):
+        """The keyboard cursor is on another element (the console names it on the answer line)."""
+
+        def __init__(self, ref: Ref) -> None:
+            super().__init__()
+            self.ref = ref
+
+    def __init__(self, sim_of: Callable[[], Simulation], pressed: Callable[[], set[Ref]], *, id: str | None = None,
+                 operable: Callable[[Ref], bool] = lambda ref: True) -> None:
         super().__init__(id=id)
         self._sim_of = sim_of
         self._pressed = pressed
+        self._operable = operable  # where the keyboard cursor may stop now (a route started: only buttons)
         self.zoom: int | None = None  # None: fit the window
         self.lpr: int | None = None
         self.layout_: Layout | None = None
@@ -262,29 +271,79 @@ class Diagram(Guarded, ScrollView, can_focus=True):
             self.post_message(self.Pressed(self.cursor))
 
     def action_cursor(self, dx: int, dy: int) -> None:
+        """An arrow: the cursor goes to the nearest operable element in that direction (:func:`nearest`); the first
+        press puts it on the element nearest the middle of the window."""
         lay = self.layout_
         if lay is None:
             return
-        targets = [(r, xy) for r, xy in lay.targets.items() if r.kind in CLICKABLE]
-        if not targets:
+        centres = self.centres()
+        if not centres:
             return
-        if self.cursor is None or self.cursor not in lay.targets:
+        if self.cursor is None or self.cursor not in centres:
             sx, sy = self.scroll_offset
-            cx, cy = sx + self.size.width // 2, sy + self.size.height // 2
-            self.cursor = min(targets, key=lambda t: abs(t[1][0] - cx) + 3 * abs(t[1][1] - cy))[0]
+            middle = (sx + self.size.width / 2, sy + self.size.height / 2)
+            self.cursor = min(centres, key=lambda r: distance(centres[r], middle))
         else:
-            x0, y0 = lay.targets[self.cursor]
-            best: tuple[float, Ref] | None = None
-            for r, (x, y) in targets:
-                ddx, ddy = x - x0, y - y0
-                along = ddx * dx + ddy * dy
-                if along <= 0 or r == self.cursor:
-                    continue
-                across = abs(ddy) if dx else abs(ddx)
-                score = along + 3 * across if dx else along * 2 + across
-                if best is None or score < best[0]:
-                    best = (score, r)
-            if best is not None:
-                self.cursor = best[1]
+            self.cursor = nearest(centres, self.cursor, (dx, dy)) or self.cursor
         self.offset_of(self.cursor)
         self.refresh()
+        self.post_message(self.CursorMoved(self.cursor))
+
+    def centres(self) -> dict[Ref, tuple[float, float]]:
+        """The middle of the cells of every element the cursor may stop on now (a section: of its band), and of the
+        one under it, where the cursor measures from."""
+        lay = self.layout_
+        if lay is None:
+            return {}
+        out: dict[Ref, tuple[float, float]] = {}
+        for ref in lay.targets:
+            if ref.kind not in KEYBOARD or not (ref == self.cursor or self._operable(ref)):
+                continue
+            cells = lay.section_cells.get(ref.id) if ref.kind == "section" else None
+            cells = cells or sorted(self._cells_of(ref))
+            out[ref] = (sum(x for x, _ in cells) / len(cells), sum(y for _, y in cells) / len(cells))
+        return out
+
+    def cursor_region(self) -> Region | None:
+        """Where the element under the cursor is on the screen, for a menu or a question about it to stand beside
+        (None when there is no cursor or it is scrolled out of view)."""
+        if self.cursor is None or self.layout_ is None or self.cursor not in self.layout_.targets:
+            return None
+        cells = self._cells_of(self.cursor)
+        sx, sy = self.scroll_offset
+        xs = [x - sx for x, _ in cells]
+        ys = [y - sy for _, y in cells]
+        if not xs or not (0 <= min(xs) < self.size.width and 0 <= ys[0] < self.size.height):
+            return None
+        region = self.content_region
+        return Region(region.x + min(xs), region.y + min(ys), max(xs) - min(xs) + 1, max(ys) - min(ys) + 1)
+
+
+KEYBOARD = ("button", "turnout", "signal", "section")  # what the arrow keys stop on
+ROW_CELLS = 2.0  # a terminal cell is about twice as tall as it is wide: a line counts as two columns
+OFF_AXIS = 2.0  # a step sideways costs as much as two steps along the arrow
+CONE = 0.5  # within about 27 degrees of the arrow: sideways at most half as far as along it
+OUTSIDE_CONE = 1000.0  # an element outside the cone is taken only when none lies within
+
+
+def distance(a: tuple[float, float], b: tuple[float, float]) -> float:
+    return abs(a[0] - b[0]) + ROW_CELLS * abs(a[1] - b[1])
+
+
+def nearest(centres: dict[Ref, tuple[float, float]], start: Ref, direction: tuple[int, int]) -> Ref | None:
+    """The element an arrow goes to from ``start``: among those ahead in ``direction`` (a unit step, (1, 0) right,
+    (0, 1) down), the one with the least distance along the arrow plus twice the distance across it, preferring
+    those within :data:`CONE` of it; None when nothing lies ahead."""
+    x0, y0 = centres[start]
+    ux, uy = direction
+    best: tuple[float, Ref] | None = None
+    for ref, (x, y) in centres.items():
+        dx, dy = x - x0, ROW_CELLS * (y - y0)
+        along = dx * ux + dy * uy
+        if ref == start or along <= 0:
+            continue
+        across = abs(dx * uy) + abs(dy * ux)
+        score = along + OFF_AXIS * across + (OUTSIDE_CONE if across > CONE * along else 0.0)
+        if best is None or score < best[0]:
+            best = (score, ref)
+    return best[1] if best is not None else None

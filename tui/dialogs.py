@@ -10,15 +10,36 @@ from __future__ import annotations
 
 from typing import ClassVar, TypeVar
 
+from rich.style import Style
+from rich.text import Text
 from textual.app import ComposeResult
 from textual.await_complete import AwaitComplete
 from textual.binding import Binding, BindingType
-from textual.containers import Grid, Vertical
+from textual.containers import Grid, Vertical, VerticalScroll
+from textual.geometry import Offset, Region, Size
 from textual.screen import ModalScreen
 from textual.widgets import Button, Input, Label, Static
 
+from liansuo.stations.printable import printable
+
 from .guard import Guarded, on_top
 from .operate import MENUS, MODES
+from .paint import (
+    BAND_COLOUR,
+    LAMP_COLOUR,
+    S_BUTTON,
+    S_COUNT,
+    S_DEAD,
+    S_DOOR,
+    S_JOINT,
+    S_LOST_ON,
+    S_MARK,
+    S_NAME,
+    S_NAME_ALARM,
+    S_PRESSED,
+    S_TRAIN,
+    S_TURNOUT,
+)
 from .plain import plain
 
 DIALOG_CSS = """
@@ -29,6 +50,32 @@ DIALOG_CSS = """
 {name} Grid {{ grid-size: 2; grid-columns: 1fr 1fr; grid-gutter: 0 1; height: auto; width: 100%; }}
 {name} Button {{ width: 100%; margin: 0; }}
 """
+
+# A menu or a question about an element stands beside it, over a diagram still drawn in full (no dimming).
+BESIDE_CSS = """
+{name} {{ align: left top; background: transparent; }}
+{name} > Vertical {{ width: 44; }}
+"""
+GAP = (3, 1)  # columns and lines kept clear between the element and a dialog beside it
+
+
+def place(box: Size, anchor: Region, screen: Size) -> Offset:
+    """Where a dialog of size ``box`` goes beside ``anchor`` (an element on the screen): below it, above it, right of
+    it or left of it, the first that fits in ``screen`` without covering the element and the ``GAP`` around it;
+    kept inside the screen."""
+    gx, gy = GAP
+    clear = anchor.grow((gy, gx, gy, gx))
+    left = anchor.x - box.width // 3
+    middle = anchor.y - box.height // 2
+    candidates = [Offset(left, clear.bottom), Offset(left, clear.y - box.height), Offset(clear.right, middle),
+                  Offset(clear.x - box.width, middle)]
+    area = Region(0, 0, screen.width, screen.height)
+    for at in candidates:
+        region = Region(at.x, at.y, box.width, box.height)
+        inside = region.translate_inside(area, True, True)
+        if area.contains_region(inside) and not inside.overlaps(clear):
+            return inside.offset
+    return Region(*candidates[0], box.width, box.height).translate_inside(area, True, True).offset
 
 T = TypeVar("T")
 
@@ -41,6 +88,24 @@ class Dialog(Guarded, ModalScreen[T]):
     """A modal screen that is answered at most once. What it focuses first is its ``AUTO_FOCUS`` (Textual focuses it
     when the dialog shows, and quietly does nothing for a dialog closed before it showed)."""
 
+    beside: Region | None = None  # the dialog stands beside this region of the screen (:func:`place`)
+
+    def on_mount(self) -> None:
+        if self.beside is not None:
+            self.call_after_refresh(self.place_beside)
+
+    def on_resize(self) -> None:
+        if self.beside is not None:
+            self.call_after_refresh(self.place_beside)
+
+    def place_beside(self) -> None:
+        anchor = self.beside
+        if anchor is None or not self.is_attached:
+            return
+        box = self.query_one(Vertical)
+        self.styles.align = ("left", "top")
+        box.styles.offset = place(box.outer_size, anchor, self.size)
+
     def dismiss(self, result: T | None = None) -> AwaitComplete:
         """Close with ``result`` while this dialog is the screen on top; a late second answer changes nothing."""
         if not on_top(self):
@@ -49,18 +114,22 @@ class Dialog(Guarded, ModalScreen[T]):
 
 
 class ConfirmScreen(Dialog[bool]):
-    """总人解, 区故解, 引导, 引导总锁 and 上电解锁 are confirmed before they are sent (y / Enter yes, n / Esc no)."""
+    """总人解, 区故解, 引导, 引导总锁 and 上电解锁 are confirmed before they are sent (y / Enter yes, n / Esc no). The
+    question stands beside the element it is about (``anchor``, its region on the screen), or at the foot of the
+    window over the panels; the diagram stays drawn."""
 
-    DEFAULT_CSS = dialog_css("ConfirmScreen")
+    DEFAULT_CSS = dialog_css("ConfirmScreen") + BESIDE_CSS.format(name="ConfirmScreen") + \
+        "ConfirmScreen { align: center bottom; } ConfirmScreen > Vertical { width: 60; margin: 0 0 3 0; }"
     AUTO_FOCUS = "#yes"
     BINDINGS: ClassVar[list[BindingType]] = [
         Binding("y", "answer(True)", "yes"),
         Binding("n,escape", "answer(False)", "no"),
     ]
 
-    def __init__(self, question: str) -> None:
+    def __init__(self, question: str, anchor: Region | None = None) -> None:
         super().__init__()
         self.question = question
+        self.beside = anchor
 
     def compose(self) -> ComposeResult:
         with Vertical():
@@ -77,23 +146,26 @@ class ConfirmScreen(Dialog[bool]):
 
 
 class QuitScreen(ConfirmScreen):
-    """Asked before the console closes, whichever way it is asked to (ctrl+q, the palette's Quit, ``quit``)."""
+    """Asked before the console closes, whichever way it is asked to (ctrl+q, the palette's Quit, ``quit``): in the
+    middle, over a dimmed console."""
 
-    DEFAULT_CSS = dialog_css("QuitScreen")
+    DEFAULT_CSS = dialog_css("QuitScreen") + "QuitScreen > Vertical { margin: 0; }"
 
 
 class MenuScreen(Dialog[str]):
-    """What can be done with a turnout, a signal or a section; returns the function's name ('' for none)."""
+    """What can be done with a turnout, a signal or a section; returns the function's name ('' for none). It stands
+    beside the element (``anchor``) over the diagram, which stays drawn."""
 
-    DEFAULT_CSS = dialog_css("MenuScreen")
+    DEFAULT_CSS = dialog_css("MenuScreen") + BESIDE_CSS.format(name="MenuScreen")
     AUTO_FOCUS = "Button"
     BINDINGS: ClassVar[list[BindingType]] = [Binding("escape", "close", "close")]
 
-    def __init__(self, kind: str, element: str, title: str = "") -> None:
+    def __init__(self, kind: str, element: str, title: str = "", anchor: Region | None = None) -> None:
         super().__init__()
         self.kind = kind
         self.element = element
         self.title_text = title or f"{kind} {element}"
+        self.beside = anchor
 
     def compose(self) -> ComposeResult:
         with Vertical():
@@ -141,22 +213,64 @@ Function button (bottom bar or key), then the signal / turnout / section:
   P 上电解锁 power-up release (sealed: asks at once, counted)
 Click a turnout number, a signal or a section for its menu.
 
-Arrows move the cursor, Enter presses it. Shift+arrows or the wheel
-pan; + - zoom, 0 fits.   : command bar (Tab, Up/Down, Esc)
+Arrows move the cursor to the nearest element that way (named on the
+answer line), Enter presses it. Shift+arrows or the wheel pan;
++ - zoom, 0 fits.   : command bar (Tab, Up/Down, Esc), e.g. {example}
 space pause/run   . one cycle   > < speed   a acknowledge alarms
+m mute / unmute the alarm bell (or 'mute' / 'unmute' in the bar)
 F2 instructor panel   ? this help   ctrl+q quit (asks first)
 Esc also stops a long 'run' typed in the command bar
 Replay: [ ] seek 10 s, { } 60 s, Home / End
 """
 
 
+def legend() -> Text:
+    """What each colour of the diagram means, drawn in that colour (docs/console.md, "Reading the diagram")."""
+    rows: list[tuple[str, list[tuple[str, Style]]]] = [
+        ("sections", [("━━ free", Style(color=BAND_COLOUR["free"])), ("━━ locked in a route", Style(
+            color=BAND_COLOUR["locked"])), ("━━ occupied (红光带)", Style(color=BAND_COLOUR["occupied"]))]),
+        ("turnouts", [("5 normal 定位", S_TURNOUT["normal"]), ("5 reverse 反位", S_TURNOUT["reverse"]),
+                      ("5 no indication (flashes)", S_LOST_ON)]),
+        ("marks", [("■ single lock", S_MARK["locked"]), ("× single block", S_MARK["blocked"]),
+                   ("■ guide lock", S_MARK["guide"])]),
+        ("lamps", [("● L", Style(color=LAMP_COLOUR["green"])), ("● U", Style(color=LAMP_COLOUR["yellow"])),
+                   ("● H", Style(color=LAMP_COLOUR["red"])), ("● B", Style(color=LAMP_COLOUR["white"])),
+                   ("● A", Style(color=LAMP_COLOUR["blue"])), ("○ commanded, dark", Style(color=LAMP_COLOUR["red"]))]),
+        ("names", [("X signal", S_NAME), ("X signal alarm", S_NAME_ALARM), ("178s manual release", S_COUNT)]),
+        ("buttons", [("L", S_BUTTON["train"]), ("D", S_BUTTON["shunt"]), ("BA1", S_BUTTON["variant"]),
+                     ("pressed", S_PRESSED)]),
+        ("doors", [("▬ closed", S_DOOR["closed"]), ("▭ open", S_DOOR["open"]), ("▬ bypassed", S_DOOR["bypass"])]),
+        ("joints", [("┃ joint", S_JOINT), ("╏ dead zone", S_DEAD), ("T1> train", S_TRAIN)]),
+        ("alarms", [("new: red, blinking", Style(color="#ff4040", bold=True)), ("acknowledged", Style(
+            color="#c08080"))]),
+    ]
+    out = Text("颜色 Colours\n")
+    for name, samples in rows:
+        out.append(f"  {name:9}")
+        for text, style in samples:
+            out.append("  ")
+            out.append(text, style=style)
+        out.append("\n")
+    return out
+
+
 class HelpScreen(Dialog[None]):
-    DEFAULT_CSS = dialog_css("HelpScreen") + "HelpScreen > Vertical { width: 78; }"
+    """Keys and mouse, with a command in the station's own ids, and the colour legend."""
+
+    DEFAULT_CSS = dialog_css("HelpScreen") + """
+    HelpScreen > VerticalScroll { width: 80; max-width: 100%; height: auto; max-height: 100%; padding: 0 1;
+        border: round #ffd700; background: #1b1f24; }
+    """
+    AUTO_FOCUS = "VerticalScroll"  # taller than a small window: the arrows and the wheel scroll it
     BINDINGS: ClassVar[list[BindingType]] = [Binding("escape,q,question_mark,f1", "close", "close")]
 
+    def __init__(self, example: str = "route X XI") -> None:
+        super().__init__()
+        self.example = example
+
     def compose(self) -> ComposeResult:
-        with Vertical():
-            yield Static(HELP)
+        with VerticalScroll():
+            yield Static(Text(HELP.replace("{example}", printable(self.example))) + legend())
 
     def action_close(self) -> None:
         self.dismiss(None)

@@ -98,6 +98,19 @@ class Operator:
             return f"{kind} from {self.start[0]}{via}: press the end button (Esc cancels)"
         return ""
 
+    def operable(self, ref: Ref) -> bool:
+        """Whether pressing ``ref`` now does something: with a route started only buttons, with a function armed only
+        what it acts on. The keyboard cursor stops only on these."""
+        if self.start is not None:
+            return ref.kind == "button"
+        if self.mode is None:
+            return True
+        if self.mode.target in ("signal", "throat"):
+            return ref.kind == "signal" or (ref.kind == "button" and ref.id in self.sim.station.signals)
+        if self.mode.target == "section":
+            return ref.kind in ("section", "turnout")
+        return ref.kind == "turnout"
+
     def reset(self) -> None:
         self.mode = None
         self.start = None

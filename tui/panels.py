@@ -6,7 +6,7 @@ control characters written out (:func:`~stations.printable.printable`) and never
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, ClassVar
 
@@ -21,7 +21,7 @@ from textual.widgets import Input, RichLog, Static
 from liansuo.simulation.snapshot import EventCursor
 from liansuo.stations.printable import printable
 
-from .completion import candidates, complete
+from .completion import candidates, complete, example_route
 from .guard import Guarded
 from .operate import MODES
 
@@ -54,6 +54,21 @@ def read_alarms(sim: Simulation, acknowledged: set[str]) -> list[AlarmLine]:
     out = [AlarmLine(a.key, a.t, a.text, a.key in acknowledged) for a in sim.alarm_views()]
     out.sort(key=lambda a: -1.0 if a.t is None else a.t, reverse=True)
     return out
+
+
+class AlarmBell:
+    """The terminal bell on a new alarm: due once for each alarm that appears unacknowledged (not at every redraw);
+    muted, never."""
+
+    def __init__(self, muted: bool = False) -> None:
+        self.muted = muted
+        self._unacknowledged: set[str] = set()
+
+    def due(self, alarms: Sequence[AlarmLine]) -> bool:
+        now = {a.key for a in alarms if not a.acknowledged}
+        new = now - self._unacknowledged
+        self._unacknowledged = now
+        return bool(new) and not self.muted
 
 
 class AlarmPanel(Guarded, Widget):
@@ -239,7 +254,8 @@ class CommandBar(Guarded, Input):
             self.text = text
 
     def __init__(self, sim_of: Callable[[], Simulation], *, id: str | None = None) -> None:
-        super().__init__(placeholder=": command (Tab completes, ↑↓ history), e.g. route X XI", id=id,
+        example = printable(example_route(sim_of()))  # in the station's own ids
+        super().__init__(placeholder=f": command (Tab completes, ↑↓ history), e.g. {example}", id=id,
                          suggester=CommandSuggester(sim_of))
         self._sim_of = sim_of
         self.history: list[str] = []
