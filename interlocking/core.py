@@ -315,6 +315,26 @@ class Core:
             return f"a lamp of signal {r.signal} for {aspect} is dark"
         return ""
 
+    def waiting(self, rs: RouteState) -> str:
+        """Why the signal of a route the interlocking holds is at stop, in a signaller's words: the first condition
+        not met (:meth:`open_blocker`'s, in its order), or what the route waits for before those are judged. '' when
+        the signal is open or the route is past waiting (in use, releasing). Reads only: nothing changes."""
+        stage, signal = rs.stage, rs.route.signal
+        if stage is RouteStage.setting:
+            for t in rs.all_turnouts:
+                ind = self.board.indication(t.id)
+                if ind != t.position:
+                    doing = "is moving" if t.id in self.moving else "has no indication" if ind is None else "is"
+                    return f"turnout {t.id} {doing}{f' {ind}' if doing == 'is' else ''}: the route needs it " \
+                        f"{t.position.value}"
+            return ""
+        if stage is RouteStage.locked:
+            return self.open_blocker(rs)
+        if stage is RouteStage.closed:
+            why = self.open_blocker(rs)
+            return why or f"signal {signal} was closed: the conditions are back, reopen it (重开, 'reopen {signal}')"
+        return ""
+
     def liaison_blocker(self, r: Route) -> str:
         if r.exit_link in self.links:
             link = self.links[r.exit_link]

@@ -63,6 +63,22 @@ def _route(kind: Kind) -> Handler:
     return handler
 
 
+# sealed buttons (铅封按钮), by their command: each accepted use is counted (``World.sealed_uses``). 'guide-lock'
+# counts the locking only (breaking the seal); 'guide-unlock' restores the button. SGA, the 64D accident button, is
+# counted as 'block-line accident'.
+SEALED = ("release", "fault-release", "guide", "guide-lock", "power-up-release", "axle-reset", "block-line accident")
+
+
+def _sealed(name: str, handler: Handler) -> Handler:
+    def counted(sim: World, args: list[str]) -> Result:
+        result = handler(sim, args)
+        if result.ok:
+            sim.count_sealed(name)
+        return result
+
+    return counted
+
+
 def _one(name: str, fn: Callable[[World, str], Result]) -> Handler:
     def handler(sim: World, args: list[str]) -> Result:
         if len(args) != 1:
@@ -183,7 +199,10 @@ def _run(sim: World, args: list[str]) -> Result:
 def _block_line(sim: World, args: list[str]) -> Result:
     if len(args) != 2:
         return Result.refuse(f"usage: {USAGE['block-line']}")
-    return sim.interlocking.operator.block_line(args[0], args[1])
+    result = sim.interlocking.operator.block_line(args[0], args[1])
+    if result.ok and args[1] == "accident":
+        sim.count_sealed("block-line accident")
+    return result
 
 
 def _line_direction(sim: World, args: list[str]) -> Result:
@@ -232,11 +251,13 @@ _HANDLERS: dict[str, Handler] = {
     "route": _route("train"),
     "shunt": _route("shunt"),
     "cancel": _one("cancel", lambda s, a: s.interlocking.operator.cancel(a)),
-    "release": _one("release", lambda s, a: s.interlocking.operator.release(a)),
-    "fault-release": _one("fault-release", lambda s, a: s.interlocking.operator.fault_release(a)),
+    "release": _sealed("release", _one("release", lambda s, a: s.interlocking.operator.release(a))),
+    "fault-release": _sealed("fault-release",
+                             _one("fault-release", lambda s, a: s.interlocking.operator.fault_release(a))),
     "reopen": _one("reopen", lambda s, a: s.interlocking.operator.reopen(a)),
-    "guide": _one("guide", lambda s, a: s.interlocking.operator.guide(a)),
-    "guide-lock": _one("guide-lock", lambda s, a: s.interlocking.operator.guide_lock(a, True)),
+    "guide": _sealed("guide", _one("guide", lambda s, a: s.interlocking.operator.guide(a))),
+    "guide-lock": _sealed("guide-lock",
+                          _one("guide-lock", lambda s, a: s.interlocking.operator.guide_lock(a, True))),
     "guide-unlock": _one("guide-unlock", lambda s, a: s.interlocking.operator.guide_lock(a, False)),
     "throw": _throw,
     "lock": _one("lock", lambda s, a: s.interlocking.operator.single_lock(a, True)),
@@ -245,10 +266,10 @@ _HANDLERS: dict[str, Handler] = {
     "unblock": _one("unblock", lambda s, a: s.interlocking.operator.single_block(a, False)),
     "block-line": _block_line,
     "line-direction": _line_direction,
-    "power-up-release": _power_up_release,
+    "power-up-release": _sealed("power-up-release", _power_up_release),
     "restart": _restart,
     "neighbour": _neighbour,
-    "axle-reset": _one("axle-reset", lambda s, a: s.interlocking.operator.axle_reset(a)),
+    "axle-reset": _sealed("axle-reset", _one("axle-reset", lambda s, a: s.interlocking.operator.axle_reset(a))),
     "doors": _doors,
     "fault": _fault,
     "repair": _repair,

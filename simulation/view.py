@@ -206,6 +206,16 @@ class InterlockingView:
         """Every route the interlocking holds, in order of selection."""
         return tuple(_route(rs) for rs in self._il.routes.values())
 
+    def waiting(self, signal: str) -> str:
+        """Why ``signal`` is at stop over the route set from it, in a signaller's words: the first of the
+        interlocking's opening conditions not met ('block line XL has not been accepted ... (64D: idle)', 'screen
+        doors P3:right are not closed and locked ...', 'turnout 5 is moving: ...'); '' with no route set, with
+        the signal open, or once a train is in the route."""
+        require("signal", signal, self._signals, self._station)
+        rid = self._il.by_signal.get(signal)
+        rs = None if rid is None else self._il.routes.get(rid)
+        return "" if rs is None else self._il.core.waiting(rs)
+
     def route_state(self, route_id: str) -> str:
         """The route's state word, 'released' while the interlocking does not hold it."""
         require("route", route_id, self._routes, self._station)

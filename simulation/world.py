@@ -56,6 +56,7 @@ class World:
         self.parked: dict[str, list[Axle]] = {}  # named sets of wheelsets placed by hand (``axles`` command)
         self.events: deque[Event] = deque(maxlen=20_000)  # the world's own events: trains, faults
         self.alarms: dict[str, str] = {}  # the world's alarms (derailment, squeeze by a train)
+        self.sealed: dict[str, int] = {}  # sealed button (铅封) -> its accepted uses (see ``sealed_uses``)
         for reason in self.field.held_down().values():  # sections past their track-circuit model's range
             self.log("alarm", reason)
         motion = make_engine(engine, self.station, cycle_s)
@@ -193,6 +194,16 @@ class World:
         if track == OUTSIDE:  # the head has run out over the boundary; the rear is still in
             return TrainView(tr.name, sections, speed, tr.direction.value, tr.mode, None, None, "leaving", cab)
         return TrainView(tr.name, sections, speed, tr.direction.value, tr.mode, track, round(x, 2), tr.state, cab)
+
+    def count_sealed(self, button: str) -> None:
+        """One more accepted use of a sealed button (铅封按钮), named by its command."""
+        self.sealed[button] = self.sealed.get(button, 0) + 1
+
+    def sealed_uses(self) -> dict[str, int]:
+        """The sealed buttons' counters (铅封计数): command -> accepted uses in this world, such as
+        ``{'release': 2, 'guide': 1}``; a button not used yet is absent. They survive a ``restart``, like the counters
+        on the console."""
+        return dict(self.sealed)
 
     def alarm_views(self) -> list[AlarmView]:
         """Active alarms: the interlocking's, then the world's."""

@@ -34,6 +34,7 @@ def run(test: Callable[..., Awaitable[None]]) -> Callable[..., None]:
 
 
 async def click(pilot: Any, ref: Ref) -> None:
+    await pilot.pause()  # the diagram centres itself after its first refresh (when the station is wider than it)
     diagram = pilot.app.diagram
     await pilot.click(Diagram, offset=diagram.offset_of(ref))
     await pilot.pause()
@@ -391,17 +392,20 @@ async def test_after_a_restart_the_sealed_power_up_release_button_asks_counts_an
         assert "上电锁闭" in message(app)  # the route is refused while the station is power-up locked
         app.send("occupy 3G", "instructor")
         await function(pilot, "power-up")  # the sealed button acts on the whole station: it asks at once
-        assert isinstance(app.screen, ConfirmScreen) and "counter 1" in app.screen.question
+        assert isinstance(app.screen, ConfirmScreen) and "used 0 times" in app.screen.question
         await pilot.press("y")
         await pilot.pause()
         assert "3G" in message(app) and app.sim.section_state("7DG") == "locked"  # refused: a section occupied
         app.send("vacate 3G", "instructor")
         cycles(app, 2)
-        await pilot.press("P")  # its key, a second use: the counter goes on
-        assert isinstance(app.screen, ConfirmScreen) and "counter 2" in app.screen.question
+        await pilot.press("P")  # its key, a second press: the refused use was not counted
+        assert isinstance(app.screen, ConfirmScreen) and "used 0 times" in app.screen.question
         await pilot.press("y")
         await pilot.pause()
         assert app.sim.section_state("7DG") == "free" and "in service" in message(app)
+        assert app.sim.sealed_uses() == {"power-up-release": 1}
+        bar = str(app.function_bar.render())
+        assert "上电解锁 1" in bar or "上电 1" in bar  # the counter beside the button
         await click(pilot, Ref("button", "X", "train"))
         await click(pilot, Ref("button", "XI", "train"))
         cycles(app, 40)

@@ -53,6 +53,7 @@ from .panels import (
     StatusBar,
     clock_text,
     read_alarms,
+    waiting_text,
 )
 from .safeapp import SafeApp
 
@@ -128,6 +129,7 @@ class ConsoleApp(SafeApp):
         self._ticks = 0
         self.warm_up = True
         self._status = Text()
+        self._waiting = ""  # why a signal stays red over its route, as last said (panels.waiting_text)
         self.instructor_panel: InstructorPanel | None = None  # mounted the first time instructor mode opens
         self.long_run: LongRun | None = None
         self.recorder: FileRecorder | None = None
@@ -279,6 +281,12 @@ class ConsoleApp(SafeApp):
         if self.instructor and self.instructor_panel is not None:
             self.instructor_panel.show_faults(sim)
         self.function_bar.set_armed(self.operator.mode.name if self.operator.mode else None)
+        self.function_bar.set_counts(sim.sealed_uses())
+        waiting = waiting_text(sim, self.diagram.cursor)
+        if waiting != self._waiting:  # a signal newly waiting: say why on the answer line too
+            self._waiting = waiting
+            if waiting:
+                self.say(waiting)
         status = self.status_text(alarms=sum(not a.acknowledged for a in alarms))
         if status != self._status:
             self._status = status
@@ -299,6 +307,8 @@ class ConsoleApp(SafeApp):
             out.append(f"│ ⚠ {alarms} alarm{'s' if alarms > 1 else ''} ", style="bold #ff4040")
         if self.alarm_bell.muted:
             out.append("│ 🔕 bell muted (m) ", style="#ffd700")
+        if self._waiting:
+            out.append(f"│ {self._waiting} ", style="#ff8080")
         counting = self.diagram.frame().countdown if self.diagram.layout_ is not None else {}
         if counting:
             out.append("│ 人解 " + " ".join(f"{s} {n}s" for s, n in sorted(counting.items())) + " ", style="#ffd700")

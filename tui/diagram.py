@@ -27,7 +27,7 @@ from .paint import S_CURSOR, Frame, add_overlays, glyph, read_frame
 if TYPE_CHECKING:
     from liansuo.simulation.sim import Simulation
 
-CLICKABLE = ("button", "turnout", "signal", "section", "platform")
+CLICKABLE = ("button", "turnout", "signal", "section", "platform", "block")
 
 
 class Diagram(Guarded, ScrollView, can_focus=True):

@@ -32,26 +32,27 @@ FOULING = "┿"
 LAMP = "●"
 
 ROLE_PRIORITY = {"diag": 0, "band": 0, "node": 1, "fp": 1, "joint": 2, "end": 2, "label": 3, "door": 4, "plabel": 4,
-                 "tlabel": 5, "tmark": 5, "signame": 5, "lamp": 6, "button": 6}
+                 "tlabel": 5, "tmark": 5, "signame": 5, "lamp": 6, "button": 6, "blamp": 6}
 
 
 @dataclass(frozen=True)
 class Ref:
-    """What a cell shows: ``kind`` is section, turnout, signal, button, joint, end, platform or fouling."""
+    """What a cell shows: ``kind`` is section, turnout, signal, button, joint, end, platform, fouling, line (a block
+    line's name and lamps) or block (a block line's button)."""
 
     kind: str
     id: str
-    sub: str = ""  # button kind (train, shunt, end, exit, variant); door key for platforms
+    sub: str = ""  # button kind (train, shunt, end, exit, variant); door key for platforms; block button (BSA ...)
 
 
 @dataclass
 class Glyph:
     ch: str
-    role: str  # band, diag, node, joint, end, fp, label, tlabel, tmark, lamp, signame, button, door, plabel
+    role: str  # band, diag, node, joint, end, fp, label, tlabel, tmark, lamp, signame, button, door, plabel, blamp
     ref: Ref | None
     section: str = ""  # the section whose band colour this cell takes (band, diag, node, fp, label)
     leg: tuple[str, str] | None = None  # (turnout, leg) for the cell next to a turnout on that leg
-    slot: int = 0  # lamp slot of a signal; door index of a platform
+    slot: int = 0  # lamp slot of a signal; door index of a platform; block lamp (0 departure, 1 arrival)
     also: str = ""  # a second section drawn over the same cell (a crossing)
 
 
@@ -83,6 +84,8 @@ class Layout:
     # signal -> places for its release countdown, best first: (x, y, step) where the text starts and grows by step
     countdown_at: dict[str, list[tuple[int, int, int]]] = field(default_factory=dict)
     section_cells: dict[str, list[tuple[int, int]]] = field(default_factory=dict)
+    # track -> (position of its left end, of its right end, its cells from left to right): where a train's head is
+    track_cells: dict[str, tuple[float, float, list[tuple[int, int]]]] = field(default_factory=dict)
     lpr: int = 3
     zoom: int = 1
 
@@ -99,6 +102,16 @@ class Layout:
 # ---- the builder ----------------------------------------------------------------------------------------------------
 ZOOM_K = (0.18, 0.35, 0.6, 0.9, 1.3)  # columns per sqrt(metre) between neighbouring positions, by zoom level
 MAX_ZOOM = len(ZOOM_K) - 1
+BLOCK_KINDS = ("64d", "station")  # lines whose block the operator sees on the diagram (automatic block has signals)
+BLOCK_BUTTONS = ("BSA", "FUA", "SGA")  # 64D: block (闭塞按钮), restore (复原按钮), accident (事故按钮)
+MIN_DOORS = 4  # screen doors drawn at least, beside the platform's id
+MAX_DOORS = 12
+
+
+def platform_track(station: Station, section: str) -> str | None:
+    """The track a platform at ``section`` is drawn along: the section's longest."""
+    tracks = station.section_tracks.get(section, [])
+    return max(tracks, key=lambda t: station.track_span(t)[1] - station.track_span(t)[0], default=None)
 
 
 class _Builder:
@@ -174,6 +187,8 @@ class _Builder:
         self._signal_items()
         self._turnout_items()
         self._variant_items()
+        self._block_items()
+        self._platform_room()
 
     def lamp_slots(self, signal: str) -> int:
         have = {lamp.value for lamp in self.st.signals[signal].lamps}
@@ -225,6 +240,50 @@ class _Builder:
                         cells.append((first + i, ch, role, tref, slot))
                 edge = first - 1 if down else first + n
             self.items.append(Item(y + 1 if down else y - 1, self.pos_of(node), cells, 2))
+
+    def _block_items(self) -> None:
+        """A block line's panel beside its end, outwards, on the line above the track: its name, the departure and
+        arrival lamps (发车, 接车 表示灯) and, on a 64D line, the block (BSA), restore (FUA) and accident (SGA)
+        buttons."""
+        st = self.st
+        for lk in st.model.links:
+            if lk.kind.value not in BLOCK_KINDS or lk.end not in st.node_tracks:
+                continue
+            line = Ref("line", lk.id)
+            cells: list[tuple[str, str, Ref | None, int]] = [(ch, "plabel", line, 0) for ch in lk.id]
+            cells += [(" ", "gap", None, 0), (LAMP, "blamp", line, 0), (LAMP, "blamp", line, 1)]
+            if lk.kind.value == "64d":
+                for button in BLOCK_BUTTONS:
+                    cells.append((" ", "gap", None, 0))
+                    cells += [(ch, "button", Ref("block", lk.id, button), 0) for ch in button]
+            at_left = self._free_side(lk.end) == "up"
+            first = -len(cells) - 1 if at_left else 2
+            placed = [(first + i, ch, role, ref, slot) for i, (ch, role, ref, slot) in enumerate(cells)
+                      if role != "gap"]
+            self.items.append(Item(self.line(self.nrows[lk.end]) - 1, self.pos_of(lk.end), placed, 2))
+
+    def _platform_room(self) -> None:
+        """Room along each platform's track for its id and at least ``MIN_DOORS`` doors on each doors' line,
+        clear of the labels (signals, buttons) that stand at the track's two ends on that line and of the track's
+        own diagonals, so the platform is drawn at every zoom."""
+        st = self.st
+        for p in st.model.platforms:
+            track = platform_track(st, p.section)
+            if track is None:
+                continue
+            a, b = st.track_ports[track]
+            pa, pb = sorted((self.pos_of(a.node), self.pos_of(b.node)))
+            if pa == pb:
+                continue
+            yt = self.line(self.rows[track])
+            ends = sorted((a.node, b.node), key=self.pos_of)
+            da, db = (abs(self.line(self.nrows[n]) - yt) for n in ends)
+            for sd in p.screen_doors or []:
+                line = yt - 1 if sd.side.value == "left" else yt + 1
+                left = max([da] + [it.hi for it in self.items if it.line == line and it.pos == pa and it.priority])
+                right = max([db] + [-it.lo for it in self.items if it.line == line and it.pos == pb and it.priority])
+                # free cells run from col[pa] + left + 2 to col[pb] - right - 2, each with free neighbours
+                self.pairs.append((pa, pb, left + right + 3 + len(p.id) + 1 + MIN_DOORS))
 
     def _free_side(self, node: str) -> str:
         """For a button at an end: the side of the line away from its track, i.e. where the line leads."""
@@ -356,6 +415,7 @@ def _paint(b: _Builder, col: list[int], lay: Layout) -> None:
             path.append((xb - i, yb + (i if yt > yb else -i), DIAG_DOWN if yb > yt else DIAG_UP))
         if x1 >= x0:
             runs.setdefault(sec, []).append((yt, x0, x1))
+        lay.track_cells[tid] = (st.node_at(a.node), st.node_at(bb.node), [(x, y) for x, y, _ in path])
         for k, (x, y, ch) in enumerate(path):
             leg = None
             if k == 0 and a.leg in ("normal", "reverse"):
@@ -421,10 +481,9 @@ def _paint_nodes(b: _Builder, lay: Layout, cx: dict[str, int], cy: dict[str, int
 def _paint_platforms(b: _Builder, lay: Layout, cx: dict[str, int], cy: dict[str, int]) -> None:
     st = b.st
     for p in st.model.platforms:
-        tracks = st.section_tracks.get(p.section, [])
-        if not tracks:
+        best = platform_track(st, p.section)
+        if best is None:
             continue
-        best = max(tracks, key=lambda t: abs(cx[st.track_ports[t][1].node] - cx[st.track_ports[t][0].node]))
         a, bb = st.track_ports[best]
         x0, x1 = sorted((cx[a.node], cx[bb.node]))
         y = b.line(b.rows[best])
@@ -439,7 +498,7 @@ def _paint_platforms(b: _Builder, lay: Layout, cx: dict[str, int], cy: dict[str,
             key = f"{p.id}:{sd.side.value}"
             ref = Ref("platform", p.id, key)
             span = _longest_run(free)
-            n_doors = min(len(span) - len(p.id) - 1, 12)
+            n_doors = min(len(span) - len(p.id) - 1, MAX_DOORS)
             start = span[0] + (len(span) - (len(p.id) + 1 + n_doors)) // 2
             for i, ch in enumerate(p.id):
                 _put(lay, start + i, line, Glyph(ch, "plabel", ref))

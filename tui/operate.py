@@ -7,8 +7,9 @@ refusal comes back with its reason.
 
 Function buttons (总取消, 总人解, 区故解, 引导, 引导总锁, 总定位/总反位, 单锁/单解, 单封/解封, 重开) arm a mode;
 the next press on the diagram names its target. Those a real console asks to confirm (总人解, 区故解, 引导,
-引导总锁) come back with a question for the operator. The sealed power-up release (上电解锁) acts on the whole station:
-pressing it asks at once, and every use is counted, as the counter beside a sealed button (铅封按钮) does.
+引导总锁) come back with a question for the operator. The sealed buttons (铅封按钮: 总人解, 区故解, 引导, 引导总锁,
+上电解锁) have counters of their accepted uses, kept by the simulation (``sim.sealed_uses()``) and shown beside them.
+The power-up release (上电解锁) acts on the whole station: pressing it asks at once, with its counter.
 """
 
 from __future__ import annotations
@@ -31,16 +32,21 @@ class Mode:
     target: str  # signal, section, turnout, throat, or station (no target: the button acts at once)
     template: str
     confirm: bool = False
-    sealed: bool = False  # a sealed button (铅封): each use is counted
+    sealed: bool = False  # a sealed button (铅封): each accepted use is counted by the simulation
     short: str = ""  # its label on a narrow function bar, when shorter than ``zh``
+
+    @property
+    def command(self) -> str:
+        """The command it sends, which names its counter in ``sim.sealed_uses()``."""
+        return self.template.split()[0]
 
 
 MODES: dict[str, Mode] = {m.name: m for m in [
     Mode("cancel", "c", "总取消", "cancel", "signal", "cancel {}"),
-    Mode("release", "r", "总人解", "manual release", "signal", "release {}", True),
-    Mode("fault-release", "f", "区故解", "fault release", "section", "fault-release {}", True),
-    Mode("guide", "g", "引导", "guide", "signal", "guide {}", True),
-    Mode("guide-lock", "G", "引导总锁", "guide lock", "throat", "guide-lock {}", True),
+    Mode("release", "r", "总人解", "manual release", "signal", "release {}", True, sealed=True),
+    Mode("fault-release", "f", "区故解", "fault release", "section", "fault-release {}", True, sealed=True),
+    Mode("guide", "g", "引导", "guide", "signal", "guide {}", True, sealed=True),
+    Mode("guide-lock", "G", "引导总锁", "guide lock", "throat", "guide-lock {}", True, sealed=True),
     Mode("normal", "n", "总定位", "normal", "turnout", "throw {} normal"),
     Mode("reverse", "v", "总反位", "reverse", "turnout", "throw {} reverse"),
     Mode("lock", "l", "单锁", "lock", "turnout", "lock {}"),
@@ -75,7 +81,6 @@ class Operator:
         self.mode: Mode | None = None
         self.start: tuple[str, str] | None = None  # (signal, train|shunt)
         self.via: list[str] = []
-        self.sealed_uses: dict[str, int] = {}  # sealed button -> times it was pressed (its counter)
 
     # ---- state shown on the diagram ----
     def pressed(self) -> set[Ref]:
@@ -127,8 +132,8 @@ class Operator:
             self.mode = None
             count = ""
             if m.sealed:
-                n = self.sealed_uses[m.name] = self.sealed_uses.get(m.name, 0) + 1
-                count = f" (sealed button 铅封, counter {n})"
+                n = self.sim.sealed_uses().get(m.command, 0)
+                count = f" (sealed button 铅封, used {n} time{'' if n == 1 else 's'})"
             return Outcome(command=m.template, confirm=f"{m.zh} ({m.en}){count}: {m.template}?")
         self.mode = m
         return Outcome(message=self.prompt())
@@ -152,7 +157,25 @@ class Operator:
             return Outcome(message=f"insulated joint {ref.id}{extra}")
         if ref.kind == "platform":
             return Outcome(message=f"platform {ref.id}: screen doors {ref.sub}")
+        if ref.kind == "block":
+            return self._block_button(ref.id, ref.sub)
+        if ref.kind == "line":
+            return Outcome(message=f"block line {ref.id}: {self.sim.view.block_line(ref.id) or 'automatic block'}")
         return Outcome()
+
+    def _block_button(self, link: str, button: str) -> Outcome:
+        """A 64D block line's buttons: BSA (闭塞按钮) requests the block, or accepts the neighbour's request;
+        FUA (复原按钮) restores it after the arrival, or cancels it before a departure; SGA (事故按钮, sealed)
+        forces it back to normal after asking. The interlocking judges each and says why it refuses."""
+        state = self.sim.view.block_line(link)
+        if button == "BSA":
+            return Outcome(command=f"block-line {link} {'accept' if state == 'asked' else 'request'}")
+        if button == "FUA":
+            return Outcome(command=f"block-line {link} {'restore' if state == 'arrived' else 'cancel'}")
+        n = self.sim.sealed_uses().get("block-line accident", 0)
+        command = f"block-line {link} accident"
+        return Outcome(command=command, confirm=f"事故 SGA (accident, sealed button 铅封, used {n} time"
+                                                f"{'' if n == 1 else 's'}): {command}?")
 
     def apply(self, mode_name: str, ref: Ref) -> Outcome:
         """A function applied to an element (from an armed function button or an element's menu)."""

@@ -4,8 +4,10 @@ Sections: a plain band when free, white when locked in a route, red when occupie
 green at normal, yellow at reverse, flashing red without indication; the leg not set is left open at the turnout;
 a red mark for single lock (单锁), a red cross for single block (单封), a white mark for guide total lock. Signals:
 the lamps actually lit in the field (a flashing USU lamp blinks with the flasher), a dark lamp of the commanded
-aspect as a hollow circle; the countdown of a manual release beside the signal. Platform doors: green closed and
-locked, yellow open, magenta bypassed (互锁解除). Trains: their name on the sections they occupy.
+aspect as a hollow circle; the countdown of a manual release beside the signal. Block lines: the departure and
+arrival lamps yellow (asked for), green (given), red (a train on the line), hollow when dark. Platform doors: green
+closed and locked, yellow open, magenta bypassed (互锁解除). Trains: their name at the head of the train (车次窗), the
+arrow leading.
 """
 
 from __future__ import annotations
@@ -45,6 +47,12 @@ S_LOST_ON = Style(color="#ffffff", bgcolor="#ff2020", bold=True)
 S_LOST_OFF = Style(color="#ff2020", bold=True)
 S_MARK = {"locked": Style(color="#ff2020", bold=True), "blocked": Style(color="#ff2020", bold=True),
           "guide": Style(color="#ffffff", bold=True)}
+# a block line's state -> the colours of its departure (发车) and arrival (接车) lamps, '' dark: yellow asked for,
+# green given, red a train on the line (64D: requested / asked, permitted / accepted, departed / arriving, arrived;
+# station block: outbound, departed / inbound, arriving)
+BLOCK_LAMPS = {"idle": ("", ""), "requested": ("yellow", ""), "permitted": ("green", ""), "departed": ("red", ""),
+               "asked": ("", "yellow"), "accepted": ("", "green"), "arriving": ("", "red"), "arrived": ("", "red"),
+               "outbound": ("green", ""), "inbound": ("", "green")}
 S_DOOR = {"closed": Style(color="#00e050"), "open": Style(color="#ffd700", bold=True),
           "bypass": Style(color="#e070e0", bold=True)}
 
@@ -60,6 +68,7 @@ class Frame:
     alarmed: set[str]
     doors: dict[str, str]
     flash: bool
+    blocks: dict[str, str] = field(default_factory=dict)  # block line -> its state (view.block_line)
     overlay: dict[tuple[int, int], tuple[str, Style]] = field(default_factory=dict)
 
 
@@ -85,8 +94,10 @@ def read_frame(sim: Simulation, lay: Layout) -> Frame:
     doors: dict[str, str] = {}
     for key, d in sim.field.doors.items():
         doors[key] = "bypass" if d.pdqcj else "open" if d.is_open else "closed"
+    blocks = {lk.id: state for lk in st.model.links if (state := view.block_line(lk.id)) is not None}
     lost = any(pos is None for pos, _ in turnouts.values())
-    return Frame(sections, turnouts, lamps, countdown, alarmed, doors, int(sim.t * 2) % 2 == 0 if lost else True)
+    return Frame(sections, turnouts, lamps, countdown, alarmed, doors, int(sim.t * 2) % 2 == 0 if lost else True,
+                 blocks=blocks)
 
 
 def add_overlays(frame: Frame, sim: Simulation, lay: Layout) -> None:
@@ -105,26 +116,44 @@ def add_overlays(frame: Frame, sim: Simulation, lay: Layout) -> None:
         cells = sorted({c for s in tv.sections for c in lay.section_cells.get(s, [])}, key=lambda c: (c[1], c[0]))
         if not cells:
             continue
-        run = _longest_run(cells)
-        arrow = ">" if tv.direction == "down" else "<"
+        down = tv.direction == "down"
+        arrow = ">" if down else "<"
         name = printable(tv.name)
-        text = f"{name}{arrow}" if tv.direction == "down" else f"{arrow}{name}"
+        text = f"{name}{arrow}" if down else f"{arrow}{name}"
+        runs = _runs(cells)
+        head = head_cell(lay, tv.head_track, tv.head_m)
+        run = next((r for r in runs if head in r and len(r) >= len(text)), None)
+        if run is None or head is None:  # the head on a diagonal or beyond the station: the longest run, its head end
+            run = max(runs, key=len)
+            head = run[-1] if down else run[0]
         text = text[: len(run)] if len(run) < len(text) else text
-        start = (len(run) - len(text)) // 2
+        # the arrow on the head's cell, the name trailing behind it, kept within the run
+        at = run.index(head) - (len(text) - 1 if down else 0)
+        start = max(0, min(len(run) - len(text), at))
         for i, ch in enumerate(text):
             ov[run[start + i]] = (ch, S_TRAIN)
 
 
-def _longest_run(cells: list[tuple[int, int]]) -> list[tuple[int, int]]:
-    best: list[tuple[int, int]] = []
-    cur: list[tuple[int, int]] = []
+def head_cell(lay: Layout, track: str | None, m: float | None) -> tuple[int, int] | None:
+    """The cell of the diagram where a train's head (its leading wheelset, at ``m`` along ``track``) is drawn."""
+    if track is None or m is None or track not in lay.track_cells:
+        return None
+    left, right, cells = lay.track_cells[track]
+    if not cells:
+        return None
+    share = 0.5 if right == left else min(1.0, max(0.0, (m - left) / (right - left)))
+    return cells[round(share * (len(cells) - 1))]
+
+
+def _runs(cells: list[tuple[int, int]]) -> list[list[tuple[int, int]]]:
+    """Cells sorted by line then column, cut into horizontal runs of neighbouring cells."""
+    out: list[list[tuple[int, int]]] = []
     for c in cells:
-        if cur and (c[1] != cur[-1][1] or c[0] != cur[-1][0] + 1):
-            cur = []
-        cur.append(c)
-        if len(cur) > len(best):
-            best = list(cur)
-    return best
+        if out and c[1] == out[-1][-1][1] and c[0] == out[-1][-1][0] + 1:
+            out[-1].append(c)
+        else:
+            out.append([c])
+    return out
 
 
 def band_style(frame: Frame, g: Glyph) -> Style:
@@ -162,6 +191,10 @@ def glyph(frame: Frame, g: Glyph, pressed: set[Ref]) -> tuple[str, Style]:
             return " ", S_DIM
         colour, lit = shown[g.slot]
         return ("●", Style(color=LAMP_COLOUR.get(colour, "white"), bold=True)) if lit else ("○", S_DIM)
+    if role == "blamp":
+        assert g.ref is not None
+        colour = BLOCK_LAMPS.get(frame.blocks.get(g.ref.id, "idle"), ("", ""))[g.slot]
+        return ("●", Style(color=LAMP_COLOUR[colour], bold=True)) if colour else ("○", S_DIM)
     if role == "signame":
         assert g.ref is not None
         return g.ch, S_NAME_ALARM if g.ref.id in frame.alarmed else S_NAME

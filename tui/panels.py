@@ -23,10 +23,25 @@ from liansuo.stations.printable import printable
 
 from .completion import candidates, complete, example_route
 from .guard import Guarded
+from .layout import Ref
 from .operate import MODES
 
 if TYPE_CHECKING:
     from liansuo.simulation.sim import Simulation
+
+
+def waiting_text(sim: Simulation, focus: Ref | None) -> str:
+    """Why a signal stays red over its locked route ('XI red: block line SL has not been accepted ...'): the signal
+    under the cursor (its lamp, name or button) if its route waits, else the route set last that waits; '' if none."""
+    view = sim.view
+    signals = [r.signal for r in reversed(view.routes())]
+    if focus is not None and focus.kind in ("signal", "button") and focus.id in sim.station.signals:
+        signals.insert(0, focus.id)
+    for signal in signals:
+        why = view.waiting(signal)
+        if why:
+            return printable(f"{signal} red: {why}")
+    return ""
 
 
 def clock_text(t: float) -> str:
@@ -166,17 +181,29 @@ class FunctionBar(Guarded, Widget):
         super().__init__(id=id)
         self.armed: str | None = None
         self.spans: list[tuple[int, int, str]] = []
+        self.counts: dict[str, int] = {}  # sealed button's command -> its accepted uses (铅封计数)
+
+    def set_counts(self, uses: dict[str, int]) -> None:
+        """The sealed buttons' counters, from ``sim.sealed_uses()``: shown beside each used one (总人解 3)."""
+        if uses != self.counts:
+            self.counts = dict(uses)
+            self.refresh()
 
     def set_armed(self, mode: str | None) -> None:
         if mode != self.armed:
             self.armed = mode
             self.refresh()
 
+    def _count(self, name: str) -> str:
+        m = MODES[name]
+        n = self.counts.get(m.command, 0) if m.sealed else 0
+        return f" {n}" if n else ""
+
     def _labels(self, width: int) -> list[tuple[str, str]]:
-        long = [(m.name, f"{m.key}:{m.zh}") for m in MODES.values()]
+        long = [(m.name, f"{m.key}:{m.zh}{self._count(m.name)}") for m in MODES.values()]
         if sum(len(t) + sum(1 for c in t if ord(c) > 0x2E80) + 1 for _, t in long) <= width:
             return long
-        return [(m.name, m.short or m.zh) for m in MODES.values()]
+        return [(m.name, f"{m.short or m.zh}{self._count(m.name)}") for m in MODES.values()]
 
     def render(self) -> Text:
         out = Text()

@@ -33,8 +33,8 @@ class ReplayApp(ConsoleApp):
         Binding("right_square_bracket", "seek(10)", "+10s", key_display="]"),
         Binding("left_curly_bracket", "seek(-60)", "-60s", show=False),
         Binding("right_curly_bracket", "seek(60)", "+60s", show=False),
-        Binding("home", "seek_to(0)", "start", show=False),
-        Binding("end", "seek_to(-1)", "end", show=False),
+        Binding("home", "seek_to(0)", "start", show=False, priority=True),  # over the diagram's scrolling
+        Binding("end", "seek_to(-1)", "end", show=False, priority=True),
     ]
 
     def __init__(self, rec: Recording, station: Station | None = None, *, speed: float = 1.0,
