@@ -122,6 +122,7 @@ def lamp(app, signal):
 async def main():
     app = ConsoleApp("jiaopei", paused=True)
     async with app.run_test(size=(120, 36)) as pilot:
+        await pilot.pause()  # the diagram centres itself after its first refresh
         print("lamp X before", *lamp(app, "X"), "red" if lamp(app, "X")[1] == LAMP_COLOUR["red"] else "not red")
         for button in ("X", "XI"):
             await pilot.click(Diagram, offset=app.diagram.offset_of(Ref("button", button, "train")))
