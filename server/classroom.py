@@ -22,25 +22,36 @@ MAX_STEPS = 400  # cycles one seat may catch up in one advance: a stalled server
 
 
 @dataclass
-class Seat:
-    number: int
+class Desk:
+    """A simulation and its clock: a seat's own, or one a team of seats shares."""
+
     sim: Simulation
-    trainee: str = ""
-    token: str = ""  # held by the client that took the seat; a reconnect shows it to take the seat back
-    connected: bool = False
     paused: bool = False
     speed: float = 1.0
     debt: float = 0.0
+
+
+@dataclass
+class Seat:
+    number: int
+    desk: Desk
+    trainee: str = ""
+    token: str = ""  # held by the client that took the seat; a reconnect shows it to take the seat back
+    connected: bool = False
     refused: int = 0  # the trainee's refused commands
     log: list[tuple[float, str, str, bool, str]] = field(default_factory=list)  # (t, who, line, ok, answer)
 
+    @property
+    def sim(self) -> Simulation:
+        return self.desk.sim
+
     def summary(self) -> dict[str, Any]:
         """What the instructor's dashboard shows of this seat."""
-        alarms = self.sim.alarm_views()
-        return {"seat": self.number, "station": self.sim.station.id, "trainee": self.trainee,
-                "connected": self.connected, "t": self.sim.t, "paused": self.paused, "speed": self.speed,
-                "alarms": len(alarms), "refused": self.refused, "commands": sum(w != INSTRUCTOR for _, w, *_ in
-                                                                                self.log)}
+        d = self.desk
+        return {"seat": self.number, "station": d.sim.station.id, "trainee": self.trainee,
+                "connected": self.connected, "t": d.sim.t, "paused": d.paused, "speed": d.speed,
+                "alarms": len(d.sim.alarm_views()), "refused": self.refused,
+                "commands": sum(w != INSTRUCTOR for _, w, *_ in self.log)}
 
 
 class SeatError(ValueError):
@@ -48,12 +59,25 @@ class SeatError(ValueError):
 
 
 class Classroom:
-    def __init__(self, station: str, seats: int, *, cycle_s: float = 0.25) -> None:
+    def __init__(self, station: str, seats: int, *, cycle_s: float = 0.25, shared: bool = False) -> None:
+        """``seats`` seats of ``station``: each with a simulation of its own, or all at one (``shared``: a team
+        exercise, where every seat operates the same station and its clock)."""
         if not 1 <= seats <= 64:
             raise SeatError(f"a classroom has 1 to 64 seats, not {seats}")
         self.station_ref = station
         self.cycle_s = cycle_s
-        self.seats = {n: Seat(n, Simulation(station, cycle_s=cycle_s)) for n in range(1, seats + 1)}
+        self.shared = shared
+        team = Desk(Simulation(station, cycle_s=cycle_s)) if shared else None
+        self.seats = {n: Seat(n, team or Desk(Simulation(station, cycle_s=cycle_s))) for n in range(1, seats + 1)}
+
+    def desks(self, seats: list[int] | None = None) -> list[Desk]:
+        """The desks of these seats (of all seats for None), each once."""
+        out: list[Desk] = []
+        for n in self.seats if seats is None else seats:
+            d = self.seat(n).desk
+            if all(d is not o for o in out):
+                out.append(d)
+        return out
 
     # ---- what a client sees -------------------------------------------------------------------------------------
     def station_source(self) -> dict[str, str]:
@@ -66,7 +90,7 @@ class Classroom:
     def snapshot(self, seat: int, role: str, cursor: EventCursor) -> dict[str, Any]:
         s = self.seat(seat)
         data = snapshot(s.sim, role, cursor)
-        data.update(type="snapshot", seat=seat, paused=s.paused, speed=s.speed)
+        data.update(type="snapshot", seat=seat, paused=s.desk.paused, speed=s.desk.speed)
         return data
 
     def summaries(self) -> list[dict[str, Any]]:
@@ -115,32 +139,32 @@ class Classroom:
     def set_clock(self, seats: list[int], *, paused: bool | None = None, speed: float | None = None) -> None:
         if speed is not None and not 0.1 <= speed <= 64:
             raise SeatError(f"a speed is 0.1 to 64 times real time, not {speed:g}")
-        for n in seats:
-            s = self.seat(n)
+        for d in self.desks(seats):
             if paused is not None:
-                s.paused = paused
+                d.paused = paused
             if speed is not None:
-                s.speed = speed
+                d.speed = speed
 
     def reset(self, seats: list[int]) -> None:
-        """A fresh simulation of the station on each seat; the seat keeps its trainee."""
-        for n in seats:
-            s = self.seat(n)
-            s.sim.close()
-            s.sim = Simulation(self.station_ref, cycle_s=self.cycle_s)
-            s.debt, s.refused, s.log = 0.0, 0, []
+        """A fresh simulation of the station on each seat's desk; the seat keeps its trainee."""
+        for d in self.desks(seats):
+            d.sim.close()
+            d.sim, d.debt = Simulation(self.station_ref, cycle_s=self.cycle_s), 0.0
+        for s in self.seats.values():
+            if any(s.desk is d for d in self.desks(seats)):
+                s.refused, s.log = 0, []
 
     def advance(self, wall_s: float) -> None:
-        """Run every seat's clock on by ``wall_s`` seconds of the wall clock, at its speed."""
-        for s in self.seats.values():
-            if s.paused:
+        """Run every desk's clock on by ``wall_s`` seconds of the wall clock, at its speed."""
+        for d in self.desks():
+            if d.paused:
                 continue
-            s.debt += wall_s * s.speed
-            n = min(int(s.debt / s.sim.cycle_s), MAX_STEPS)
-            s.debt = min(s.debt - n * s.sim.cycle_s, s.sim.cycle_s)
+            d.debt += wall_s * d.speed
+            n = min(int(d.debt / d.sim.cycle_s), MAX_STEPS)
+            d.debt = min(d.debt - n * d.sim.cycle_s, d.sim.cycle_s)
             for _ in range(n):
-                s.sim.step()
+                d.sim.step()
 
     def close(self) -> None:
-        for s in self.seats.values():
-            s.sim.close()
+        for d in self.desks():
+            d.sim.close()

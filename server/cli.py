@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import asyncio
 import getpass
+import socket
 import sys
 from collections.abc import Callable
 from typing import TYPE_CHECKING
@@ -23,12 +24,22 @@ def register(add: Add) -> None:
     sp = add("serve", cmd_serve, "serve a classroom: one simulation per trainee seat, and the instructor")
     sp.add_argument("station", nargs="?", default="jiaopei", help="bundled station name or path (default jiaopei)")
     sp.add_argument("--seats", type=int, default=2, metavar="N", help="trainee seats, 1 to 64 (default 2)")
+    sp.add_argument("--shared", action="store_true",
+                    help="a team exercise: every seat operates one simulation of the station, with one clock")
     sp.add_argument("--host", default="127.0.0.1",
                     help="address to listen on (default 127.0.0.1: this machine only; 0.0.0.0 for a classroom)")
     sp.add_argument("--port", type=int, default=8765, metavar="P", help="port (default 8765; 0 picks a free one)")
     sp.add_argument("--password-file", metavar="FILE",
                     help="the instructor's password: a hash written by --hash-password (or a password); without it "
                          "the environment variable LIANSUO_INSTRUCTOR_PASSWORD")
+    sp.add_argument("--web", action="store_true",
+                    help="also serve the console client to browsers (textual-serve): trainees and the instructor "
+                         "need nothing but a browser")
+    sp.add_argument("--web-port", type=int, default=8000, metavar="P",
+                    help="with --web: the browsers' port (default 8000; 0 picks a free one)")
+    sp.add_argument("--public-url", metavar="URL",
+                    help="with --web: the address browsers use to reach this machine, when it is not "
+                         "http://HOST:PORT (behind a proxy, or --host 0.0.0.0)")
     sp.add_argument("--hash-password", action="store_true",
                     help="read a password on the terminal (or standard input), print its hash for --password-file, "
                          "and exit")
@@ -43,8 +54,9 @@ def cmd_serve(args: argparse.Namespace) -> int:
             return refuse("serve", "an empty password protects nothing", Exit.USAGE)
         print(hash_password(pw))
         return 0
-    if not 0 <= args.port <= 65535:
-        return refuse("serve", f"--port is 0 to 65535, not {args.port}", Exit.USAGE)
+    for name, port in (("--port", args.port), ("--web-port", args.web_port)):
+        if not 0 <= port <= 65535:
+            return refuse("serve", f"{name} is 0 to 65535, not {port}", Exit.USAGE)
     try:
         stored = instructor_hash(args.password_file)
     except PasswordError as exc:
@@ -53,14 +65,22 @@ def cmd_serve(args: argparse.Namespace) -> int:
     from .websocket import ClassroomServer
 
     try:
-        classroom = Classroom(args.station, args.seats)
+        classroom = Classroom(args.station, args.seats, shared=args.shared)
     except StationError as exc:
         return bad_input(exc)
     except SeatError as exc:
         return refuse("serve", str(exc), Exit.USAGE)
     server = ClassroomServer(classroom, stored)
+    web_port: int | None = None
+    if args.web:
+        try:
+            web_port = _free(args.host, args.web_port)
+        except OSError as exc:
+            classroom.close()
+            return refuse("serve", f"cannot serve browsers on {args.host}:{args.web_port}: {exc.strerror or exc}",
+                          Exit.USAGE)
     try:
-        asyncio.run(_serve(server, args.host, args.port, len(classroom.seats)))
+        asyncio.run(_serve(server, args.host, args.port, web_port, args.public_url))
     except OSError as exc:
         return refuse("serve", f"cannot listen on {args.host}:{args.port}: {exc.strerror or exc}", Exit.USAGE)
     except KeyboardInterrupt:
@@ -70,13 +90,35 @@ def cmd_serve(args: argparse.Namespace) -> int:
     return 0
 
 
-async def _serve(server: ClassroomServer, host: str, port: int, seats: int) -> None:
+def _free(host: str, port: int) -> int:
+    """``port`` (or a free one for 0) once it is known that it can be listened on: raises OSError if not."""
+    with socket.socket(socket.AF_INET6 if ":" in host else socket.AF_INET) as s:
+        s.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        s.bind((host, port))
+        return int(s.getsockname()[1])
+
+
+async def _serve(server: ClassroomServer, host: str, port: int, web_port: int | None, public_url: str | None) -> None:
     ready: asyncio.Future[int] = asyncio.get_running_loop().create_future()
     task = asyncio.create_task(server.serve(host, port, ready))
     while not ready.done():  # listening, or the task ended: the OSError of a port it could not listen on goes up
         if task.done():
             task.result()
         await asyncio.sleep(0.01)
-    print(f"liansuo serve: {seats} seats of {server.classroom.station_ref} on ws://{host}:{ready.result()} "
-          f"(ctrl+c stops)", flush=True)
-    await task
+    seats = len(server.classroom.seats)
+    browsers = ""
+    web = None
+    if web_port is not None:
+        from . import web as webserver
+
+        web = webserver.start(webserver.local_url(host, ready.result()), host, web_port, public_url)
+        browsers = f", browsers on {public_url or f'http://{host}:{web_port}'}"
+    of = "at one simulation of" if server.classroom.shared else "of"
+    print(f"liansuo serve: {seats} seats {of} {server.classroom.station_ref} on ws://{host}:{ready.result()}"
+          f"{browsers} (ctrl+c stops)", flush=True)
+    try:
+        await task
+    finally:
+        if web is not None:
+            web.terminate()
+            web.join(5)

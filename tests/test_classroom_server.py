@@ -15,6 +15,7 @@ from websockets.sync.client import connect
 
 from liansuo.server.client import ClassroomClient, ClassroomError
 from liansuo.simulation.passwords import hash_password, instructor_hash, matches
+from liansuo.simulation.snapshot import EventCursor
 
 PASSWORD = "correct horse"
 
@@ -133,3 +134,28 @@ def test_no_password_means_no_server(tmp_path: Path, monkeypatch: pytest.MonkeyP
         instructor_hash(None)
     with pytest.raises(ValueError, match="cannot read"):
         instructor_hash(tmp_path / "missing")
+
+
+def test_a_team_shares_one_station_and_its_clock() -> None:
+    from liansuo.server.classroom import Classroom
+
+    team = Classroom("jiaopei", 3, shared=True)
+    try:
+        assert team.command(1, "trainee", "route X XI").ok
+        team.advance(8.0)
+        assert "X-XI" in {r.id for r in team.seat(3).sim.view.routes()}  # seat 3 sees seat 1's route
+        team.set_clock([2], paused=True)
+        t = team.seat(1).sim.t
+        team.advance(2.0)
+        assert team.seat(1).sim.t == t and team.snapshot(3, "trainee", EventCursor())["paused"] is True
+        team.reset([1])
+        assert not team.seat(2).sim.view.routes()
+    finally:
+        team.close()
+    alone = Classroom("jiaopei", 2)
+    try:
+        assert alone.command(1, "trainee", "route X XI").ok
+        alone.advance(8.0)
+        assert not alone.seat(2).sim.view.routes()
+    finally:
+        alone.close()
