@@ -19,6 +19,7 @@ from liansuo.interlocking import cli as interlocking
 from liansuo.proving import cli as proving
 from liansuo.proving import mutation, soakcli
 from liansuo.proving.verify import cli as verify
+from liansuo.remote import cli as remote
 from liansuo.server import cli as server
 from liansuo.stations import cli as stations
 from liansuo.stations.jsonreport import version
@@ -42,7 +43,7 @@ REGISTER: tuple[Callable[[Add], None], ...] = (
     mutation.register,  # mutate
     fuzz.register,  # fuzz
     bench.register,  # bench
-    tui.register,  # tui
+    partial(tui.register, connect=remote.cmd_connect),  # tui (--connect: the classroom's client)
     tui.register_replay,  # replay
     server.register,  # serve
 )

@@ -30,8 +30,13 @@ class EventCursor:
         self._last: dict[int, Event | None] = {}
 
     def fresh(self, sim: Simulation, role: str) -> list[Event]:
+        return self.fresh_from(sim.view.events(), sim.events, role)
+
+    def fresh_from(self, interlocking: Sequence[Event], world: Sequence[Event], role: str) -> list[Event]:
+        """The events of the two logs (the interlocking's, the world's; live sequences, newest last) not read yet,
+        in time order; of the world's, a trainee's only alarms and power."""
         out: list[Event] = []
-        for i, dq in enumerate((sim.view.events(), sim.events)):
+        for i, dq in enumerate((interlocking, world)):
             last = self._last.get(i)
             got: list[Event] = []
             for e in reversed(dq):
@@ -63,6 +68,9 @@ def snapshot(sim: Simulation, role: str, cursor: EventCursor) -> dict[str, Any]:
         "lines": {lk.id: view.block_line(lk.id) for lk in st.model.links},
         "trains": [asdict(tv) for tv in trains],
         "alarms": [asdict(a) for a in sim.alarm_views()],
+        "sealed": sim.sealed_uses(),
+        "waiting": {r.signal: why for r in view.routes() if (why := view.waiting(r.signal))},
+        "faults": [f.describe() for f in sim.field.faults.values()] if role == INSTRUCTOR else [],
         "events": [[e.t, e.kind, e.text] for e in cursor.fresh(sim, role)],
     }
 
@@ -83,6 +91,14 @@ class SnapshotView:
         self.trains = [_train(d) for d in data["trains"]]
         self.alarm_list = [AlarmView(**d) for d in data["alarms"]]
         self.new_events = [Event(float(t), str(k), str(x)) for t, k, x in data["events"]]
+        self.sealed: dict[str, int] = {str(k): int(v) for k, v in data.get("sealed", {}).items()}
+        self._waiting: dict[str, str] = dict(data.get("waiting", {}))
+        self.faults: list[str] = [str(f) for f in data.get("faults", [])]
+
+    def waiting(self, signal: str) -> str:
+        """Why ``signal`` stays red over its route, as the server's interlocking said ('' if it does not wait)."""
+        require("signal", signal, self._signals, self._station)
+        return self._waiting.get(signal, "")
 
     def aspect(self, signal: str) -> str:
         require("signal", signal, self._signals, self._station)

@@ -9,10 +9,12 @@ import networkx as nx
 
 ROOT = Path(__file__).resolve().parents[1]
 LAYERS = ("rules", "stations", "circuits", "interlocking", "simulation", "proving", "bench", "tui", "server",
-          "cli")
+          "remote", "cli")
 # the floor of each layer: a module imports only from its own layer or from a lower floor (README.md, "Layout")
 FLOOR = {"rules": 0, "stations": 1, "circuits": 2, "interlocking": 2, "simulation": 3, "proving": 4, "tui": 4,
-         "server": 4, "bench": 5, "cli": 6}  # bench measures what proving runs (verify, soak), so it stands above it
+         "server": 4, "bench": 5, "remote": 5, "cli": 6}
+# bench measures what proving runs (verify, soak), so it stands above it; remote (the classroom's clients) puts the
+# console (tui) on the server's seats, so it stands above both
 
 
 def test_every_layer_is_linked_into_the_package() -> None:

@@ -33,6 +33,7 @@ from liansuo.stations.printable import printable
 from liansuo.stations.source import StationError
 
 from .completion import example_route
+from .consolesim import ConsoleSim
 from .describe import describe
 from .diagram import Diagram
 from .dialogs import ConfirmScreen, HelpScreen, MenuScreen, PasswordScreen
@@ -72,6 +73,12 @@ def who(source: str) -> str:
 
 class ConsoleApp(SafeApp):
     TITLE = "liansuo 联锁"
+    # The console runs its simulation's clock (pause, speed, a typed 'run' in slices); a classroom's client does not:
+    # the server runs it (remote/app.py)
+    LOCAL_CLOCK = True
+    # The console refuses a trainee's instructor commands itself; a classroom's client leaves that to the server,
+    # which answers and counts them
+    LOCAL_ROLES = True
     # No text selection with the mouse, as on a CBI display: a press is always an operation. (Textual's selection also
     # kept the widget under a press and failed when a burst of input removed it before the release.)
     ALLOW_SELECT = False
@@ -105,10 +112,10 @@ class ConsoleApp(SafeApp):
     def __init__(self, station: str = "jiaopei", *, paused: bool = False, speed: float = 1.0,
                  instructor_password: str | None = None, instructor_hash: str | None = None,
                  record: str | Path | None = None, exercise: str | Path | None = None, cycle_s: float = 0.25,
-                 sim: Simulation | None = None, mute: bool = False) -> None:
+                 sim: ConsoleSim | None = None, mute: bool = False) -> None:
         super().__init__()
         self.station_ref = station
-        self.sim = sim if sim is not None else Simulation(station, cycle_s=cycle_s)
+        self.sim: ConsoleSim = sim if sim is not None else Simulation(station, cycle_s=cycle_s)
         self.operator = Operator(self.sim)
         self.paused = paused
         self.speed = speed
@@ -133,7 +140,7 @@ class ConsoleApp(SafeApp):
         self.instructor_panel: InstructorPanel | None = None  # mounted the first time instructor mode opens
         self.long_run: LongRun | None = None
         self.recorder: FileRecorder | None = None
-        if record is not None:
+        if record is not None and isinstance(self.sim, Simulation):
             self.recorder = FileRecorder(self.sim, record)
             self.recorder.attach()
 
@@ -334,16 +341,18 @@ class ConsoleApp(SafeApp):
             self.log_panel.add(f"{self.sim.t:9.2f} {'refused':8} {line}: {why}", "#ff8080")
             self.say(why, False)
             return Result.refuse(why)
-        if source == "trainee" and command_word(line) != "run" and (no := refusal(TRAINEE, line)) is not None:
+        if source == "trainee" and self.LOCAL_ROLES and command_word(line) != "run" and \
+                (no := refusal(TRAINEE, line)) is not None:
             # the console's own clock ('run') is the trainee's too; the world around the console is not
-            why = f"{no.message}; the instructor opens their panel with F2"
+            why = f"{no.message}{self.instructor_hint()}"
             self.log_panel.add(f"{self.sim.t:9.2f} {'refused':8} {line}: {why}", "#ff8080")
             self.say(why, False)
             return Result.refuse(why)
         if self.recorder is not None:
             self.recorder.source = source
         try:
-            seconds = requested_run(self.sim, line) if source in ("trainee", "instructor") else None
+            seconds = requested_run(self.sim, line) if self.LOCAL_CLOCK and source in ("trainee", "instructor") \
+                else None
             if seconds is not None:
                 self.log_panel.add(f"{self.sim.t:9.2f} {who(source):8} {line}", "#9fd3ff")
                 result = self.start_run(line, source, seconds)
@@ -368,6 +377,10 @@ class ConsoleApp(SafeApp):
 
     def say(self, text: str, ok: bool | None = None) -> None:
         self.message_line.say(text, ok)
+
+    def instructor_hint(self) -> str:
+        """Said after a trainee's refused instructor command: where the instructor sends it."""
+        return "; the instructor opens their panel with F2"
 
     def on_command_bar_hint(self, event: CommandBar.Hint) -> None:
         self.say(event.text)
@@ -555,6 +568,9 @@ class ConsoleApp(SafeApp):
 
     def load_exercise(self, path: str) -> None:
         self.stop_run()
+        if not isinstance(self.sim, Simulation):
+            self.say("an exercise runs on the simulation's own computer: start it from there", False)
+            return
         try:
             ex = parse_exercise(path)
         except StationError as exc:
@@ -577,7 +593,7 @@ class ConsoleApp(SafeApp):
 
     def check_exercise(self) -> None:
         ex = self.exercise
-        if ex is None:
+        if ex is None or not isinstance(self.sim, Simulation):
             return
         self.goal = check_goal(self.sim, ex)
         if self.goal.reached and self.goal_reached_at is None:

@@ -29,9 +29,11 @@ Handler = Callable[[argparse.Namespace], int]
 Add = Callable[[str, Handler, str], argparse.ArgumentParser]
 
 
-def register(add: Add) -> None:
+def register(add: Add, connect: Handler | None = None) -> None:
+    """``connect``: what runs ``liansuo tui --connect URL`` (the classroom's client, a floor above the console)."""
     sp = add("tui", cmd_tui, "open the operator console (操作表示机) on a station")
-    sp.add_argument("station", nargs="?", default="jiaopei", help="bundled station name or path (default jiaopei)")
+    sp.set_defaults(connect_handler=connect)
+    sp.add_argument("station", nargs="?", default=None, help="bundled station name or path (default jiaopei)")
     sp.add_argument("--paused", action="store_true", help="start with the clock paused")
     sp.add_argument("--speed", type=positive_number, default=1.0, metavar="X",
                     help="simulated seconds per wall-clock second, greater than 0 (default 1)")
@@ -43,6 +45,15 @@ def register(add: Add) -> None:
                          "(or a password); else LIANSUO_INSTRUCTOR_PASSWORD; never on the command line, where ps "
                          "shows it")
     sp.add_argument("--mute", action="store_true", help="start with the alarm bell muted (m or 'unmute' turns it on)")
+    room = sp.add_argument_group("classroom", "the console as a client of 'liansuo serve' (docs/classroom.md)")
+    room.add_argument("--connect", metavar="URL",
+                      help="connect to the classroom server at URL (ws://HOST:PORT): the station and the clock are "
+                           "the server's; without --seat or --instructor a login screen asks")
+    room.add_argument("--seat", type=int, metavar="N", help="with --connect: take trainee seat N")
+    room.add_argument("--name", metavar="NAME", help="with --seat: the trainee's name, for the report")
+    room.add_argument("--instructor", action="store_true",
+                      help="with --connect: the instructor's dashboard of every seat (the password from "
+                           "--password-file, its first line the password itself, or LIANSUO_INSTRUCTOR_PASSWORD)")
 
 
 def register_replay(add: Add) -> None:
@@ -69,6 +80,11 @@ def _load(station: str) -> Station | StationError:
 
 
 def cmd_tui(args: argparse.Namespace) -> int:
+    if args.connect is not None:
+        return _connect(args)
+    if (given := _classroom_only(args)) is not None:
+        return refuse("tui", f"{given} goes with --connect URL (a seat of the classroom server)", Exit.USAGE)
+    args.station = args.station or "jiaopei"
     if isinstance(station := _load(args.station), StationError):
         return bad_input(station)
     if args.record and (why := unwritable(Path(args.record), "--record")):
@@ -100,6 +116,25 @@ def cmd_tui(args: argparse.Namespace) -> int:
         return refuse("tui", str(exc), Exit.BAD_INPUT)
     app.run()
     return closed(app, "tui")
+
+
+def _classroom_only(args: argparse.Namespace) -> str | None:
+    """The first option given that only a classroom's client takes."""
+    return next((o for o, v in (("--seat", args.seat), ("--name", args.name), ("--instructor", args.instructor))
+                 if v not in (None, False)), None)
+
+
+def _connect(args: argparse.Namespace) -> int:
+    """``--connect``: the station, the clock and the exercises are the server's, so their options are refused."""
+    local = [o for o, v in (("STATION", args.station), ("--paused", args.paused), ("--speed", args.speed != 1.0),
+                            ("--record", args.record), ("--exercise", args.exercise)) if v not in (None, False)]
+    if local:
+        return refuse("tui", f"{local[0]} is not for --connect: the classroom server holds the station, its clock "
+                      "and its exercises", Exit.USAGE)
+    handler: Handler | None = getattr(args, "connect_handler", None)
+    if handler is None:
+        return refuse("tui", "this liansuo has no classroom client", Exit.USAGE)
+    return handler(args)
 
 
 def closed(app: SafeApp, command: str) -> int:

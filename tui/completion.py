@@ -10,7 +10,7 @@ import re
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from liansuo.simulation.sim import Simulation
+    from .consolesim import ConsoleSim
 
 _EXPECT = {
     "signal": ("SIGNAL", "L|LL|LU|U|UU|USU|H|HB|B|A"),
@@ -39,7 +39,7 @@ def placeholders(usage: str) -> list[str]:
     return out
 
 
-def _ids(sim: Simulation, kind: str, words: list[str]) -> list[str]:
+def _ids(sim: ConsoleSim, kind: str, words: list[str]) -> list[str]:
     st = sim.station
     kind = kind.rstrip(".")
     if kind in ("SIGNAL",):
@@ -83,7 +83,7 @@ def _ids(sim: Simulation, kind: str, words: list[str]) -> list[str]:
     return []
 
 
-def fault_targets(sim: Simulation, kind_name: str) -> list[str]:
+def fault_targets(sim: ConsoleSim, kind_name: str) -> list[str]:
     """What a fault kind can be applied to at this station."""
     from liansuo.circuits.faults import KINDS
 
@@ -116,7 +116,7 @@ def fault_targets(sim: Simulation, kind_name: str) -> list[str]:
     return []
 
 
-def candidates(sim: Simulation, text: str) -> list[str]:
+def candidates(sim: ConsoleSim, text: str) -> list[str]:
     """Candidates for the last (partial) word of ``text``."""
     words = text.split(" ")
     partial = words[-1]
@@ -159,7 +159,7 @@ def _natural(s: str) -> tuple[object, ...]:
     return tuple(int(p) if p.isdigit() else p for p in re.split(r"(\d+)", s))
 
 
-def complete(sim: Simulation, text: str) -> tuple[str, list[str]]:
+def complete(sim: ConsoleSim, text: str) -> tuple[str, list[str]]:
     """Tab: the line completed as far as it is unambiguous, and the candidates."""
     hits = candidates(sim, text)
     head, _, partial = text.rpartition(" ")
@@ -177,7 +177,7 @@ def complete(sim: Simulation, text: str) -> tuple[str, list[str]]:
     return text, hits
 
 
-def example_route(sim: Simulation) -> str:
+def example_route(sim: ConsoleSim) -> str:
     """A command line for hints and help, in the station's own ids: the train route of its interlocking table with the
     fewest turnouts reversed (the first such; ``route X XI`` on jiaopei), else such a shunting route (``shunt D1 D7``
     on the depot)."""

@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING
 from .layout import Ref
 
 if TYPE_CHECKING:
-    from liansuo.simulation.sim import Simulation
+    from .consolesim import ConsoleSim
 
 SIGNAL_KIND = {"home": "进站信号机 home signal", "starting": "出站信号机 starting signal",
                "route": "进路信号机 route signal", "shunting": "调车信号机 shunting signal",
@@ -22,7 +22,7 @@ MARK = {"locked": ", single-locked (单锁)", "blocked": ", single-blocked (单�
         "guide": ", guide total lock (引导总锁)"}
 
 
-def describe(sim: Simulation, ref: Ref) -> str:
+def describe(sim: ConsoleSim, ref: Ref) -> str:
     """The element ``ref`` with its state, as the answer line names it."""
     st = sim.station
     if ref.kind == "signal" and ref.id in st.signals:

@@ -25,7 +25,7 @@ from .layout import MAX_ZOOM, Layout, Ref, build_layout
 from .paint import S_CURSOR, Frame, add_overlays, glyph, read_frame
 
 if TYPE_CHECKING:
-    from liansuo.simulation.sim import Simulation
+    from .consolesim import ConsoleSim
 
 CLICKABLE = ("button", "turnout", "signal", "section", "platform", "block")
 
@@ -65,7 +65,7 @@ class Diagram(Guarded, ScrollView, can_focus=True):
             super().__init__()
             self.ref = ref
 
-    def __init__(self, sim_of: Callable[[], Simulation], pressed: Callable[[], set[Ref]], *, id: str | None = None,
+    def __init__(self, sim_of: Callable[[], ConsoleSim], pressed: Callable[[], set[Ref]], *, id: str | None = None,
                  operable: Callable[[Ref], bool] = lambda ref: True) -> None:
         super().__init__(id=id)
         self._sim_of = sim_of
@@ -83,7 +83,7 @@ class Diagram(Guarded, ScrollView, can_focus=True):
 
     # ---- layout ----
     @property
-    def sim(self) -> Simulation:
+    def sim(self) -> ConsoleSim:
         return self._sim_of()
 
     def _build(self, lpr: int, zoom: int, width: int) -> Layout:

@@ -24,7 +24,7 @@ from .layout import Ref
 from .plain import plain
 
 if TYPE_CHECKING:
-    from liansuo.simulation.sim import Simulation
+    from .consolesim import ConsoleSim
 
 
 class InstructorPanel(Guarded, VerticalScroll):
@@ -52,7 +52,7 @@ class InstructorPanel(Guarded, VerticalScroll):
             super().__init__()
             self.path = path
 
-    def __init__(self, sim_of: Callable[[], Simulation], exercises: list[Path], *, id: str | None = None) -> None:
+    def __init__(self, sim_of: Callable[[], ConsoleSim], exercises: list[Path], *, id: str | None = None) -> None:
         super().__init__(id=id)
         self._sim_of = sim_of
         self.exercises = exercises
@@ -65,7 +65,7 @@ class InstructorPanel(Guarded, VerticalScroll):
         self.rec_status = Static("", id="rec-status")
 
     @property
-    def sim(self) -> Simulation:
+    def sim(self) -> ConsoleSim:
         return self._sim_of()
 
     def compose(self) -> ComposeResult:
@@ -199,7 +199,7 @@ class InstructorPanel(Guarded, VerticalScroll):
             return f"fault target: {target} (kind {kinds[0]}; other kinds: {', '.join(kinds[1:]) or 'none'})"
         return f"no fault applies to {ref.kind} {ref.id}"
 
-    def show_faults(self, sim: Simulation) -> None:
+    def show_faults(self, sim: ConsoleSim) -> None:
         active = [f.describe() for f in sim.field.faults.values()]
         text = "active: " + "; ".join(active) if active else "no active faults"
         shown = plain(text)
@@ -213,7 +213,7 @@ class InstructorPanel(Guarded, VerticalScroll):
         self.rec_status.update(plain(text))
 
 
-def default_params(sim: Simulation, kind: str, target: str, params: str = "") -> str:
+def default_params(sim: ConsoleSim, kind: str, target: str, params: str = "") -> str:
     """Parameters a fault needs that have no default: the lamp of a filament fault (the red one, the lamp of the stop
     aspect, if there is)."""
     params = params.strip()
@@ -224,7 +224,7 @@ def default_params(sim: Simulation, kind: str, target: str, params: str = "") ->
     return params
 
 
-def fault_line(sim: Simulation, kind: str, target: str, params: str = "") -> str:
+def fault_line(sim: ConsoleSim, kind: str, target: str, params: str = "") -> str:
     """The command the Inject button sends."""
     return f"fault {kind} {target} {default_params(sim, kind, target, params)}".strip()
 

@@ -22,6 +22,8 @@ from .panels import clock_text
 if TYPE_CHECKING:
     from liansuo.simulation.sim import Simulation
 
+    from .consolesim import ConsoleSim
+
 # Wall-clock seconds of simulation in one slice. The clock ticks every 0.125 s (tui/app.py, TICK_S), so a long run
 # takes less than half of each tick and keys, clicks and redraws keep the rest.
 RUN_SLICE_S = 0.05
@@ -30,7 +32,7 @@ RUN_SLICE_S = 0.05
 class _Probe:
     """The simulation as the language's ``run`` sees it, except that ``run`` only notes how long it was asked for."""
 
-    def __init__(self, sim: Simulation) -> None:
+    def __init__(self, sim: ConsoleSim) -> None:
         self._sim = sim
         self.seconds: float | None = None
 
@@ -41,7 +43,7 @@ class _Probe:
         return getattr(self._sim, name)
 
 
-def requested_run(sim: Simulation, line: str) -> float | None:
+def requested_run(sim: ConsoleSim, line: str) -> float | None:
     """The simulated seconds a ``run`` line asks for when the command language accepts it; None for any other line,
     a refused one, or a duration the clock cannot count in cycles (the language answers those itself)."""
     words = line.split("#", 1)[0].split()

@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING, Literal
 from .layout import Ref
 
 if TYPE_CHECKING:
-    from liansuo.simulation.sim import Simulation
+    from .consolesim import ConsoleSim
 
 
 @dataclass(frozen=True)
@@ -76,7 +76,7 @@ class Outcome:
 
 
 class Operator:
-    def __init__(self, sim: Simulation) -> None:
+    def __init__(self, sim: ConsoleSim) -> None:
         self.sim = sim
         self.mode: Mode | None = None
         self.start: tuple[str, str] | None = None  # (signal, train|shunt)

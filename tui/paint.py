@@ -22,7 +22,7 @@ from liansuo.stations.printable import printable
 from .layout import Glyph, Layout, Ref
 
 if TYPE_CHECKING:
-    from liansuo.simulation.sim import Simulation
+    from .consolesim import ConsoleSim
 
 # by the lamp's colour (the rule set gives each lamp's colour and their order on the mast)
 LAMP_COLOUR = {"green": "#00e050", "yellow": "#ffd700", "red": "#ff2020", "white": "#f4f4ff", "blue": "#2f6bff"}
@@ -72,7 +72,7 @@ class Frame:
     overlay: dict[tuple[int, int], tuple[str, Style]] = field(default_factory=dict)
 
 
-def read_frame(sim: Simulation, lay: Layout) -> Frame:
+def read_frame(sim: ConsoleSim, lay: Layout) -> Frame:
     view = sim.view
     st = sim.station
     sections = {s.id: s.state for s in view.sections(list(st.sections))}
@@ -100,7 +100,7 @@ def read_frame(sim: Simulation, lay: Layout) -> Frame:
                  blocks=blocks)
 
 
-def add_overlays(frame: Frame, sim: Simulation, lay: Layout) -> None:
+def add_overlays(frame: Frame, sim: ConsoleSim, lay: Layout) -> None:
     """Countdowns beside their signals and train names over the sections they occupy."""
     ov = frame.overlay
     for sig, secs in frame.countdown.items():

@@ -27,10 +27,10 @@ from .layout import Ref
 from .operate import MODES
 
 if TYPE_CHECKING:
-    from liansuo.simulation.sim import Simulation
+    from .consolesim import ConsoleSim
 
 
-def waiting_text(sim: Simulation, focus: Ref | None) -> str:
+def waiting_text(sim: ConsoleSim, focus: Ref | None) -> str:
     """Why a signal stays red over its locked route ('XI red: block line SL has not been accepted ...'): the signal
     under the cursor (its lamp, name or button) if its route waits, else the route set last that waits; '' if none."""
     view = sim.view
@@ -64,7 +64,7 @@ class AlarmLine:
     acknowledged: bool
 
 
-def read_alarms(sim: Simulation, acknowledged: set[str]) -> list[AlarmLine]:
+def read_alarms(sim: ConsoleSim, acknowledged: set[str]) -> list[AlarmLine]:
     """Active alarms of the interlocking and of the world (trains), newest first."""
     out = [AlarmLine(a.key, a.t, a.text, a.key in acknowledged) for a in sim.alarm_views()]
     out.sort(key=lambda a: -1.0 if a.t is None else a.t, reverse=True)
@@ -161,8 +161,8 @@ class EventReader:
     def reset(self) -> None:
         self._cursor = EventCursor()
 
-    def new(self, sim: Simulation, role: str) -> list[tuple[float, str, str]]:
-        return [(e.t, e.kind, e.text) for e in self._cursor.fresh(sim, role)]
+    def new(self, sim: ConsoleSim, role: str) -> list[tuple[float, str, str]]:
+        return [(e.t, e.kind, e.text) for e in self._cursor.fresh_from(sim.view.events(), sim.events, role)]
 
 
 class FunctionBar(Guarded, Widget):
@@ -245,7 +245,7 @@ class MessageLine(Guarded, Static):
 
 
 class CommandSuggester(Suggester):
-    def __init__(self, sim_of: Callable[[], Simulation]) -> None:
+    def __init__(self, sim_of: Callable[[], ConsoleSim]) -> None:
         super().__init__(use_cache=False, case_sensitive=True)
         self._sim_of = sim_of
 
@@ -280,7 +280,7 @@ class CommandBar(Guarded, Input):
             super().__init__()
             self.text = text
 
-    def __init__(self, sim_of: Callable[[], Simulation], *, id: str | None = None) -> None:
+    def __init__(self, sim_of: Callable[[], ConsoleSim], *, id: str | None = None) -> None:
         example = printable(example_route(sim_of()))  # in the station's own ids
         super().__init__(placeholder=f": command (Tab completes, ↑↓ history), e.g. {example}", id=id,
                          suggester=CommandSuggester(sim_of))

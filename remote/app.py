@@ -1,0 +1,147 @@
+"""The operator console on a seat of the classroom server (``liansuo tui --connect URL``).
+
+It is the ordinary console (:class:`~tui.app.ConsoleApp`) over a :class:`~remote.sim.RemoteSimulation`: it draws the
+seat's snapshots and sends every command to the server, which answers it. The server runs the clock, so the clock
+keys become the instructor's clock messages and are refused to a trainee; F2 (the instructor's panel) is the
+instructor's; while the connection is down the console shows the fail-safe picture and refuses commands.
+
+The instructor's client opens on the dashboard of every seat (:mod:`remote.dashboard`); from it the instructor opens a
+seat's diagram, where every command goes to that seat, and F3 goes back.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any, ClassVar
+
+from rich.text import Text
+from textual.binding import Binding, BindingType
+
+from liansuo.simulation.roles import INSTRUCTOR
+from liansuo.tui.app import SPEEDS, ConsoleApp
+from liansuo.tui.instructor import InstructorPanel
+
+from .dashboard import DashboardScreen, ExerciseChoice, ExercisePicker
+from .link import Link
+from .sim import LOST, RemoteSimulation
+
+
+class RemoteConsoleApp(ConsoleApp):
+    LOCAL_CLOCK = False
+    LOCAL_ROLES = False
+    BINDINGS: ClassVar[list[BindingType]] = [
+        *ConsoleApp.BINDINGS,
+        Binding("f3", "dashboard", "seats", key_display="F3"),
+    ]
+
+    def __init__(self, link: Link, *, mute: bool = False) -> None:
+        self.link = link
+        self.remote = RemoteSimulation(link)
+        super().__init__(self.remote.station.id, sim=self.remote, mute=mute)
+        self.instructor = link.role == INSTRUCTOR
+        self.warm_up = False
+        self._generation = link.generation
+        self._was_live = True
+
+    @property
+    def seat(self) -> int:
+        return self.remote.seat
+
+    def started(self) -> None:
+        self.remote.step()
+        self.refresh_views()
+        if self.instructor:
+            self.say(f"seat {self.seat}: every command goes to this seat; F3 the seats, F2 faults and trains")
+            self.push_screen(DashboardScreen(self.link))
+        else:
+            self.say(f"seat {self.seat} of the classroom: click a signal's L or D button to start a route; ? help")
+
+    def on_unmount(self) -> None:
+        self.link.close()
+
+    # ---- the clock: the server's ----
+    def tick(self) -> None:
+        self._ticks += 1
+        try:
+            self.remote.step()
+            self.paused, self.speed = self.remote.paused, self.remote.speed
+            live = self.link.connected
+            if live != self._was_live or self._generation != self.link.generation:
+                self._was_live, self._generation = live, self.link.generation
+                self.say(f"{LOST}: the diagram shows nothing until it is back" if not live
+                         else f"connection to the classroom server back: seat {self.seat}", live)
+                self.log_panel.add(f"{self.remote.t:9.2f} {'link':8} {'lost' if not live else 'back'}",
+                                   "#ff6060" if not live else "#80ff80")
+            self.refresh_views()
+        except Exception as exc:  # no traceback on the screen
+            incident = self.report_unexpected(exc, "the classroom link")
+            self.say(f"internal error: {incident.summary} (see the alarms)", False)
+
+    def _clock(self, **what: Any) -> None:
+        if not self.instructor:
+            self.say("the clock is the classroom's: the instructor pauses and runs it", False)
+            return
+        reply = self.link.request({"type": "clock", "seats": [self.seat], **what})
+        self.say(str(reply.get("message", reply)), reply.get("type") == "ok")
+
+    def action_pause(self) -> None:
+        self._clock(action="run" if self.remote.paused else "pause")
+
+    def action_step(self) -> None:
+        self.say("the classroom's clock does not step: pause and run it (space)", False)
+
+    def action_speed(self, step: int) -> None:
+        i = min(range(len(SPEEDS)), key=lambda k: abs(SPEEDS[k] - self.remote.speed))
+        self._clock(speed=SPEEDS[max(0, min(len(SPEEDS) - 1, i + step))])
+
+    # ---- the instructor's ----
+    async def action_instructor(self) -> None:
+        if not self.instructor:
+            self.say("F2, the instructor's panel, is on the instructor's console: a trainee's seat operates the "
+                     "station with the console's buttons", False)
+            return
+        panel = self.instructor_panel
+        if panel is None:
+            await self.set_instructor(True)
+        else:
+            panel.set_class(not panel.has_class("-shown"), "-shown")
+
+    def instructor_hint(self) -> str:
+        return ""
+
+    def action_dashboard(self) -> None:
+        if not self.instructor:
+            self.say("the seats' dashboard is the instructor's", False)
+            return
+        if not isinstance(self.screen, DashboardScreen):
+            self.push_screen(DashboardScreen(self.link))
+
+    def on_dashboard_screen_open(self, event: DashboardScreen.Open) -> None:
+        """The dashboard opens a seat: watch it, and show it from a fresh log."""
+        reply = self.link.watch(event.seat)
+        if reply.get("type") != "ok":
+            self.say(str(reply.get("message", reply)), False)
+            return
+        self.remote.step()
+        self.events.reset()
+        self.acknowledged.clear()
+        self.log_panel.add(f"{'':9} {'seat':8} seat {event.seat}", "bold #d0a0ff")
+        self.refresh_views()
+        self.say(f"seat {event.seat}: every command goes to this seat; F3 the seats", True)
+
+    def on_instructor_panel_load_exercise(self, event: InstructorPanel.LoadExercise) -> None:
+        name = Path(event.path).stem
+        self.push_screen(ExercisePicker([name], f"seat {self.seat}"), self._exercise_chosen)
+
+    def _exercise_chosen(self, choice: ExerciseChoice | None) -> None:
+        if choice is None:
+            return
+        reply = self.link.request(choice.message([self.seat]))
+        self.say(str(reply.get("message", reply)), reply.get("type") == "ok")
+
+    def status_text(self, alarms: int) -> Text:
+        out = super().status_text(alarms)
+        out.append(f"│ seat {self.seat} ", style="bold")
+        if not self.link.connected:
+            out.append(f"│ {LOST} ", style="bold #ffffff on #c00000")
+        return out

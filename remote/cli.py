@@ -1,0 +1,85 @@
+"""``liansuo tui --connect URL``: the console as a client of the classroom server (its options are registered with
+``liansuo tui`` in ``tui/cli.py``; ``cli/main.py`` hands the connecting ones here).
+
+Everything that can be wrong is said before a console starts, in one line, with exit status 2: a bad address, no
+server there, a wrong password, a seat taken.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+from pathlib import Path
+from typing import Any
+
+from liansuo.simulation.passwords import ENV
+from liansuo.stations.exitcodes import Exit, refuse
+
+
+class LoginError(ValueError):
+    """The command line's credentials cannot be used; the message says why."""
+
+
+def instructor_password(file: str | None) -> str:
+    """The instructor's password itself (the server checks it against its hash): the first line of ``file``, else
+    the environment; never the command line."""
+    if file is not None:
+        try:
+            line = Path(file).read_text(encoding="utf-8").strip().splitlines()[0].strip()
+        except (OSError, UnicodeDecodeError, IndexError) as exc:
+            raise LoginError(f"{file}: cannot read the instructor's password ({exc or 'the file is empty'})") from None
+        if line.startswith("scrypt$"):
+            raise LoginError(f"{file} holds the password's hash, which is the server's: the client needs a file "
+                             f"with the password itself (or {ENV})")
+        return line
+    plain = os.environ.get(ENV)
+    if not plain:
+        raise LoginError(f"the instructor's password: give --password-file FILE (the password on its first line) "
+                         f"or set {ENV}")
+    return plain
+
+
+def hello(args: argparse.Namespace) -> dict[str, Any] | None:
+    """The hello the command line asks for; None: ask on the login screen."""
+    if args.instructor:
+        if args.seat is not None:
+            raise LoginError("--instructor watches every seat: no --seat with it")
+        return {"role": "instructor", "password": instructor_password(args.password_file)}
+    if args.seat is None:
+        return None
+    if not 1 <= args.seat <= 64:
+        raise LoginError(f"--seat is 1 to 64, not {args.seat}")
+    return {"role": "trainee", "seat": args.seat, "name": args.name or os.environ.get("USER", "")}
+
+
+def cmd_connect(args: argparse.Namespace) -> int:
+    from liansuo.tui.cli import closed
+
+    from .link import Link, LinkError
+
+    try:
+        greeting = hello(args)
+        if not args.connect.startswith(("ws://", "wss://")):
+            raise LoginError(f"--connect takes a websocket address, ws://HOST:PORT, not {args.connect!r}")
+    except LoginError as exc:
+        return refuse("tui", str(exc), Exit.USAGE)
+    if greeting is None:
+        from .login import LoginApp
+
+        login = LoginApp(args.connect)
+        link = login.run()
+        if link is None:  # closed without logging in
+            return 0
+    else:
+        try:
+            link = Link(args.connect, greeting)
+        except LinkError as exc:
+            return refuse("tui", str(exc), Exit.USAGE)
+    from .app import RemoteConsoleApp
+
+    app = RemoteConsoleApp(link, mute=args.mute)
+    try:
+        app.run()
+    finally:
+        link.close()
+    return closed(app, "tui")

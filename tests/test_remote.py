@@ -1,0 +1,277 @@
+"""The classroom's clients (``liansuo tui --connect``) against a real classroom server: the trainee's console on a
+seat, what it shows and never shows, the instructor's dashboard and a seat opened from it, and the fail-safe picture
+while the connection is down (docs/classroom.md). The server runs in a thread of the test; the consoles are driven as
+a user drives them (Textual's Pilot)."""
+
+from __future__ import annotations
+
+import asyncio
+import functools
+import threading
+from collections.abc import Awaitable, Callable, Iterator
+from typing import Any
+
+import pytest
+
+from liansuo.remote.app import RemoteConsoleApp
+from liansuo.remote.dashboard import DashboardScreen
+from liansuo.remote.link import Link
+from liansuo.remote.sim import LOST
+from liansuo.server.classroom import Classroom
+from liansuo.server.client import ClassroomClient
+from liansuo.server.websocket import ClassroomServer
+from liansuo.simulation.passwords import hash_password
+from liansuo.tui.layout import Ref
+from liansuo.tui.paint import BAND_COLOUR, glyph
+
+PASSWORD = "correct horse"
+SIZE = (120, 36)
+
+
+class Server:
+    """A classroom server in a thread of its own, stopped and started again on the same port at will."""
+
+    def __init__(self, seats: int = 2) -> None:
+        self.classroom = Classroom("jiaopei", seats)
+        self.server = ClassroomServer(self.classroom, hash_password(PASSWORD))
+        self.loop = asyncio.new_event_loop()
+        self.thread = threading.Thread(target=self.loop.run_forever, daemon=True)
+        self.thread.start()
+        self.task: asyncio.Task[None] | None = None
+        self.port = self.start(0)
+
+    @property
+    def url(self) -> str:
+        return f"ws://127.0.0.1:{self.port}"
+
+    def start(self, port: int) -> int:
+        async def begin() -> int:
+            ready: asyncio.Future[int] = self.loop.create_future()
+            self.task = asyncio.create_task(self.server.serve("127.0.0.1", port, ready))
+            return await ready
+
+        return asyncio.run_coroutine_threadsafe(begin(), self.loop).result(10)
+
+    def stop(self) -> None:
+        async def end() -> None:
+            assert self.task is not None
+            self.task.cancel()
+            await asyncio.gather(self.task, return_exceptions=True)
+
+        asyncio.run_coroutine_threadsafe(end(), self.loop).result(10)
+
+    def close(self) -> None:
+        self.stop()
+        self.loop.call_soon_threadsafe(self.loop.stop)
+        self.thread.join(5)
+        self.classroom.close()
+
+
+@pytest.fixture
+def server() -> Iterator[Server]:
+    s = Server()
+    try:
+        yield s
+    finally:
+        s.close()
+
+
+def run(test: Callable[..., Awaitable[None]]) -> Callable[..., None]:
+    @functools.wraps(test)
+    def wrapper(*args: Any, **kwargs: Any) -> None:
+        asyncio.run(test(*args, **kwargs))
+
+    return wrapper
+
+
+async def until(pilot: Any, condition: Callable[[], bool], seconds: float = 8.0) -> None:
+    """Let the console run until ``condition`` holds (its clock takes the server's snapshots)."""
+    for _ in range(int(seconds / 0.1)):
+        if condition():
+            return
+        await pilot.pause(0.1)
+    assert condition()
+
+
+def band(app: RemoteConsoleApp, section: str) -> str:
+    """The colour the diagram draws a section's band in now."""
+    d = app.diagram
+    d.update_view()
+    assert d.layout_ is not None
+    g = d.layout_.at(*d.layout_.targets[Ref("section", section)])
+    assert g is not None
+    _, style = glyph(d.frame(), g, set())
+    return str(style.color.name if style.color else "")
+
+
+def message(app: RemoteConsoleApp) -> str:
+    return str(app.message_line.content)
+
+
+def log(app: RemoteConsoleApp) -> str:
+    return "\n".join(app.log_panel.lines_text)
+
+
+async def type_line(pilot: Any, line: str) -> None:
+    await pilot.press("colon", *[{" ": "space"}.get(c, c) for c in line], "enter")
+    await pilot.pause()
+
+
+@run
+async def test_a_trainee_sees_a_fault_as_the_cbi_shows_it_and_never_the_fault(server: Server) -> None:
+    app = RemoteConsoleApp(Link(server.url, {"role": "trainee", "seat": 1, "name": "Li"}))
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await until(pilot, lambda: app.remote.live and band(app, "IG") == BAND_COLOUR["free"])
+        with ClassroomClient.instructor(server.url, PASSWORD) as teacher:
+            assert teacher.command("fault broken-rail IG", seat=1)["ok"]
+        await until(pilot, lambda: band(app, "IG") == BAND_COLOUR["occupied"])
+        await type_line(pilot, "route X XI")
+        assert "IG" in message(app) and "✗" in message(app), message(app)  # the interlocking's own refusal
+        await until(pilot, lambda: app.remote.t > 1.0)
+        seen = log(app) + message(app)
+        assert "broken" not in seen and "fault " not in seen, seen
+        assert app.instructor_panel is None
+
+
+@run
+async def test_a_trainees_instructor_command_is_refused_with_the_reason(server: Server) -> None:
+    app = RemoteConsoleApp(Link(server.url, {"role": "trainee", "seat": 1, "name": "Li"}))
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await type_line(pilot, "fault broken-rail IG")
+        assert "belongs to the instructor" in message(app), message(app)
+        assert "refused" in log(app)
+        assert server.classroom.seat(1).sim.field.faults == {}  # nothing reached the server's simulation
+        assert server.classroom.seat(1).refused == 1  # the server judged it, and counts it for the instructor
+        await pilot.press("escape", "f2")  # from the command bar back to the diagram
+        assert "instructor's console" in message(app) and app.instructor_panel is None, message(app)
+        await pilot.press("space")
+        assert "the instructor pauses and runs it" in message(app), message(app)
+        assert not server.classroom.seat(1).paused
+
+
+@run
+async def test_a_route_set_on_the_trainees_console_is_locked_on_the_server(server: Server) -> None:
+    app = RemoteConsoleApp(Link(server.url, {"role": "trainee", "seat": 2, "name": "Wang"}))
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await type_line(pilot, "route X XI")
+        assert "✓" in message(app), message(app)
+        with ClassroomClient.instructor(server.url, PASSWORD) as teacher:
+            teacher.request({"type": "watch", "seat": 2})
+            for _ in range(8):
+                snap = teacher.snapshot()
+                if snap["seat"] == 2 and any(r["id"] == "X-XI" for r in snap["routes"]):
+                    break
+            assert any(r["id"] == "X-XI" for r in snap["routes"]), snap["routes"]
+        await until(pilot, lambda: band(app, "IG") == BAND_COLOUR["locked"])
+
+
+@run
+async def test_the_instructor_opens_a_seat_from_the_dashboard_and_faults_it(server: Server) -> None:
+    with ClassroomClient.trainee(server.url, seat=1, name="Li"):
+        app = RemoteConsoleApp(Link(server.url, {"role": "instructor", "password": PASSWORD}))
+        async with app.run_test(size=SIZE) as pilot:
+            await pilot.pause()
+            assert isinstance(app.screen, DashboardScreen)
+            dash = app.screen
+            await until(pilot, lambda: len(dash._shown) == 2)
+            assert dash._shown[0][:3] == ("1", "Li", "yes") and dash._shown[1][0] == "2"
+            await pilot.press("down", "enter")  # seat 2
+            await until(pilot, lambda: not isinstance(app.screen, DashboardScreen) and app.remote.seat == 2)
+            await until(pilot, lambda: app.remote.live and band(app, "IG") == BAND_COLOUR["free"])
+            await type_line(pilot, "fault broken-rail IG")
+            assert "✓" in message(app), message(app)
+            await until(pilot, lambda: band(app, "IG") == BAND_COLOUR["occupied"])
+            assert server.classroom.seat(2).sim.field.faults and not server.classroom.seat(1).sim.field.faults
+            await until(pilot, lambda: "fault" in log(app))  # the instructor sees every event of the seat
+            await pilot.press("f3")
+            assert isinstance(app.screen, DashboardScreen)
+            await pilot.press("p")  # the selected seat (2)
+            await until(pilot, lambda: server.classroom.seat(2).paused)
+            assert not server.classroom.seat(1).paused
+            await pilot.press("x")
+            await until(pilot, lambda: not server.classroom.seat(2).sim.field.faults)
+            await pilot.press("R")
+            await until(pilot, lambda: not server.classroom.seat(2).paused)
+
+
+@run
+async def test_connection_lost_shows_the_fail_safe_picture_and_comes_back(server: Server) -> None:
+    app = RemoteConsoleApp(Link(server.url, {"role": "trainee", "seat": 1, "name": "Li"}))
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await until(pilot, lambda: app.remote.live and band(app, "IG") == BAND_COLOUR["free"])
+        server.stop()
+        await until(pilot, lambda: band(app, "IG") == BAND_COLOUR["occupied"])
+        assert LOST in str(app.status_bar.content)
+        assert all(pos is None for pos, _ in app.diagram.frame().turnouts.values())
+        assert not any(lit for lamps in app.diagram.frame().lamps.values() for _, lit in lamps)
+        await type_line(pilot, "route X XI")
+        assert "connection to the classroom server lost" in message(app), message(app)
+        server.start(server.port)
+        await until(pilot, lambda: app.link.connected and band(app, "IG") == BAND_COLOUR["free"])
+        assert LOST not in str(app.status_bar.content)
+        await type_line(pilot, "route X XI")
+        assert "✓" in message(app), message(app)
+
+
+@pytest.mark.parametrize(("argv", "why"), [
+    (["--connect", "http://127.0.0.1:1"], "websocket address"),
+    (["--connect", "ws://127.0.0.1:1", "--seat", "1"], "cannot reach the classroom server"),
+    (["--connect", "ws://127.0.0.1:1", "--seat", "99"], "--seat is 1 to 64"),
+    (["--connect", "ws://127.0.0.1:1", "--seat", "1", "--paused"], "--paused is not for --connect"),
+    (["--seat", "1"], "--seat goes with --connect"),
+])
+def test_a_client_that_cannot_start_says_why_in_one_line(argv: list[str], why: str,
+                                                         capsys: pytest.CaptureFixture[str]) -> None:
+    from liansuo.cli.main import main
+
+    assert main(["tui", *argv]) == 2
+    err = capsys.readouterr().err
+    assert why in err and err.count("\n") == 1 and "Traceback" not in err, err
+
+
+def test_a_wrong_password_or_a_taken_seat_ends_the_client_with_status_2(
+        server: Server, tmp_path: Any, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
+    from liansuo.cli.main import main
+
+    wrong = tmp_path / "pw"
+    wrong.write_text("wrong horse\n", encoding="utf-8")
+    assert main(["tui", "--connect", server.url, "--instructor", "--password-file", str(wrong)]) == 2
+    assert "wrong instructor password" in capsys.readouterr().err
+    hashed = tmp_path / "hash"
+    hashed.write_text(hash_password(PASSWORD) + "\n", encoding="utf-8")
+    assert main(["tui", "--connect", server.url, "--instructor", "--password-file", str(hashed)]) == 2
+    assert "needs a file with the password itself" in capsys.readouterr().err
+    monkeypatch.delenv("LIANSUO_INSTRUCTOR_PASSWORD", raising=False)
+    assert main(["tui", "--connect", server.url, "--instructor"]) == 2
+    assert "LIANSUO_INSTRUCTOR_PASSWORD" in capsys.readouterr().err
+    with ClassroomClient.trainee(server.url, seat=1, name="Li"):
+        assert main(["tui", "--connect", server.url, "--seat", "1", "--name", "Qian"]) == 2
+        assert "seat 1 is taken by Li" in capsys.readouterr().err
+
+
+@run
+async def test_the_login_screen_asks_again_after_a_refusal_then_connects(server: Server) -> None:
+    from textual.widgets import Input, RadioButton, Static
+
+    from liansuo.remote.login import LoginApp
+
+    app = LoginApp(server.url)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.click(RadioButton, offset=(2, 0))  # the first: trainee, already
+        await pilot.click("#instructor")
+        app.query_one("#password", Input).value = "wrong horse"
+        await pilot.click("#connect")
+        why = app.query_one("#why", Static)
+        await until(pilot, lambda: "wrong instructor password" in str(why.content))
+        app.query_one("#password", Input).value = ""
+        await pilot.click("#password")
+        await pilot.press(*[{" ": "space"}.get(c, c) for c in PASSWORD], "enter")  # typed, and Enter connects
+        await until(pilot, lambda: app.return_value is not None)
+    link = app.return_value
+    assert link is not None and link.role == "instructor"
+    link.close()
