@@ -148,7 +148,7 @@ async def test_a_trainees_instructor_command_is_refused_with_the_reason(server: 
         assert "instructor's console" in message(app) and app.instructor_panel is None, message(app)
         await pilot.press("space")
         assert "the instructor pauses and runs it" in message(app), message(app)
-        assert not server.classroom.seat(1).paused
+        assert not server.classroom.seat(1).desk.paused
 
 
 @run
@@ -189,12 +189,12 @@ async def test_the_instructor_opens_a_seat_from_the_dashboard_and_faults_it(serv
             await pilot.press("f3")
             assert isinstance(app.screen, DashboardScreen)
             await pilot.press("p")  # the selected seat (2)
-            await until(pilot, lambda: server.classroom.seat(2).paused)
-            assert not server.classroom.seat(1).paused
+            await until(pilot, lambda: server.classroom.seat(2).desk.paused)
+            assert not server.classroom.seat(1).desk.paused
             await pilot.press("x")
             await until(pilot, lambda: not server.classroom.seat(2).sim.field.faults)
             await pilot.press("R")
-            await until(pilot, lambda: not server.classroom.seat(2).paused)
+            await until(pilot, lambda: not server.classroom.seat(2).desk.paused)
 
 
 @run
