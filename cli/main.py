@@ -14,7 +14,7 @@ from functools import partial
 
 from liansuo.bench import cli as bench
 from liansuo.circuits import phase25cli, zpwcli
-from liansuo.cli import completion, fuzz, schemas
+from liansuo.cli import completion, exercise, fuzz, schemas
 from liansuo.interlocking import cli as interlocking
 from liansuo.proving import cli as proving
 from liansuo.proving import mutation, soakcli
@@ -45,6 +45,7 @@ REGISTER: tuple[Callable[[Add], None], ...] = (
     bench.register,  # bench
     partial(tui.register, connect=remote.cmd_connect),  # tui (--connect: the classroom's client)
     tui.register_replay,  # replay
+    exercise.register,  # exercise
     server.register,  # serve
 )
 

@@ -50,8 +50,12 @@ def _expect(sim: World, args: list[str]) -> Result:
         if t not in st.turnouts:
             return Result.refuse(f"there is no turnout '{t}'")
         pos, locked = sim.turnout_state(t)
-        ok = (pos or "none") == want and (len(rest) == 2 or (rest[2] == "locked") == locked)
-        state = f"turnout {t} is {pos or 'without indication'}{' and locked' if locked else ''}"
+        mark = sim.turnout_mark(t)
+        # a third word: 'locked' (by anything), 'single-locked' (单锁), 'blocked' (单封); any other word: not locked
+        held = {"locked": locked, "single-locked": mark == "locked", "blocked": mark == "blocked"}
+        ok = (pos or "none") == want and (len(rest) == 2 or held.get(rest[2], not locked))
+        marked = {"locked": ", single-locked", "blocked": ", single-blocked", "guide": ", under guide total lock"}
+        state = f"turnout {t} is {pos or 'without indication'}{' and locked' if locked else ''}{marked.get(mark, '')}"
         return Result(ok, state + ("" if ok else f", expected {' '.join(rest[1:])}"))
     if what == "section" and len(rest) == 2:
         s, want = rest

@@ -1,11 +1,12 @@
 """Who may send which command: the trainee at an operator console (值班员) and the instructor (教员).
 
 A trainee operates the station as its signaller does, with the CBI console's buttons: routes, releases, the guide,
-turnouts, block lines. Everything that stands for the world around the console belongs to the instructor: faults and
-their repair, trains and vehicles, simulated occupancy, the neighbour station's operator, the platform doors' own
-controls, the clock, the interlocking's restart, and every question that would show what the console does not
-(``faults``, ``expect``). The classroom server refuses the instructor's commands from a trainee's seat, and the
-console refuses them while the instructor's panel is closed.
+turnouts, block lines, and writes findings in the equipment register (``diagnose``). Everything that stands for the
+world around the console belongs to the instructor: faults and their repair, trains and vehicles, simulated
+occupancy, the neighbour station's operator, the platform doors' own controls, the clock, the interlocking's
+restart, and every question that would show what the console does not (``faults``, ``expect``). The classroom
+server refuses the instructor's commands from a trainee's seat, and the console refuses them while the
+instructor's panel is closed.
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ from liansuo.interlocking.io import Result
 OPERATOR_COMMANDS = frozenset({
     "route", "shunt", "cancel", "release", "fault-release", "reopen", "guide", "guide-lock", "guide-unlock",
     "throw", "lock", "unlock", "block", "unblock", "block-line", "line-direction", "power-up-release", "axle-reset",
+    "diagnose",
 })
 
 TRAINEE = "trainee"

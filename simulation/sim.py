@@ -15,6 +15,7 @@ from __future__ import annotations
 from liansuo.interlocking.io import Result
 
 from .commands import WORLD_COMMANDS
+from .diagnosis import DIAGNOSE
 from .expect import EXPECT
 from .language import Language
 from .trains import ato, automatic
@@ -22,7 +23,7 @@ from .trains.commands import TRAIN_COMMANDS
 from .trains.fleet import Train
 from .world import World
 
-LANGUAGE: Language[Simulation] = Language(WORLD_COMMANDS, [EXPECT], TRAIN_COMMANDS)
+LANGUAGE: Language[Simulation] = Language(WORLD_COMMANDS, [DIAGNOSE], [EXPECT], TRAIN_COMMANDS)
 
 
 class Simulation(World):

@@ -30,7 +30,7 @@ HOLDS: dict[Kind, str] = {
     "station": "'id:', 'name:', 'ends:', 'tracks:' and 'sections:'",
     "script": "'station:' and 'tests:'",
     "scenario": "'station:' and 'steps:'",
-    "exercise": "'title:', 'station:', 'setup:' and 'goal:'",
+    "exercise": "'title:', 'station:', 'setup:' and 'goal:' or 'goals:'",
     "recording": "a header line and one JSON record a line",
 }
 # top-level keys only a file of that kind has
@@ -38,7 +38,7 @@ _SIGNS: dict[Kind, frozenset[str]] = {
     "station": frozenset({"ends", "tracks", "sections", "signals", "turnouts", "joints", "platforms"}),
     "script": frozenset({"tests"}),
     "scenario": frozenset({"steps"}),
-    "exercise": frozenset({"title", "setup", "goal"}),
+    "exercise": frozenset({"title", "setup", "goal", "goals", "briefing"}),
 }
 
 

@@ -428,3 +428,25 @@ async def test_the_trainees_command_bar_refuses_the_instructors_commands_and_hid
         await pilot.press("f2")  # no password set: the instructor's panel opens, and their commands go through
         await pilot.press("colon", *"faults", "enter")
         assert "broken-rail" in message(app)
+
+
+@run
+async def test_an_exercise_with_several_goals_keeps_each_goal_once_met_and_shows_its_briefing() -> None:
+    """jiaopei-64d-departure: X3 shows green (goal 1), then the train leaves and X3 is red again while the line shows
+    departed (goal 2): the console ticks goal 1 for good and reaches the exercise's goal with both."""
+    app = ConsoleApp("jiaopei", paused=True, exercise="jiaopei-64d-departure")
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        assert app.exercise is not None and len(app.exercise.goals) == 2
+        log = "\n".join(app.log_panel.lines_text)
+        assert "The down freight train T2 is ready on the siding 3G" in log and "(seed " in log
+        assert app.send("route X3 S").ok and app.send("block-line SL request").ok
+        cycles(app, 40)
+        app.check_exercise()
+        assert app.goal is not None and app.goal.met == [True, False] and app.goal_reached_at is None
+        for _ in range(30):
+            cycles(app, 8)
+            app.check_exercise()
+        assert app.sim.aspect("X3") == "H"  # the train has gone: goal 1's green is long over
+        assert app.goal.met == [True, True] and app.goal_reached_at is not None
+        assert "goal reached" in message(app)

@@ -12,6 +12,7 @@ alarm panel and the console carries on (:mod:`tui.guard`, :mod:`tui.incidents`),
 from __future__ import annotations
 
 import os
+import random
 import time
 from pathlib import Path
 from typing import ClassVar
@@ -130,6 +131,7 @@ class ConsoleApp(SafeApp):
         self.exercise: Exercise | None = None
         self.goal: GoalCheck | None = None
         self.goal_reached_at: float | None = None
+        self.goals_met: set[int] = set()  # goals of the exercise met so far (a goal once met stays met)
         self._exercise_arg = exercise
         self._debt = 0.0
         self._wall = time.monotonic()
@@ -585,8 +587,10 @@ class ConsoleApp(SafeApp):
             return
         self.exercise = ex
         self.goal_reached_at = None
-        self.log_panel.add(f"{self.sim.t:9.2f} {'lesson':8} {ex.title}: {ex.description}", "#d0a0ff")
-        for line in ex.setup:
+        self.goals_met = set()
+        seed = random.randrange(1_000_000)  # the pool's draw; the log names it so a lesson can be given again
+        self.log_panel.add(f"{self.sim.t:9.2f} {'lesson':8} {ex.title}: {ex.briefing} (seed {seed})", "#d0a0ff")
+        for line in ex.lines(seed):
             self.send(line, "exercise")
         self.say(f"exercise: {ex.title}. Goal: {ex.goal}")
         self.check_exercise()
@@ -595,7 +599,7 @@ class ConsoleApp(SafeApp):
         ex = self.exercise
         if ex is None or not isinstance(self.sim, Simulation):
             return
-        self.goal = check_goal(self.sim, ex)
+        self.goal = check_goal(self.sim, ex, self.goals_met)
         if self.goal.reached and self.goal_reached_at is None:
             self.goal_reached_at = self.sim.t
             self.log_panel.add(f"{self.sim.t:9.2f} {'lesson':8} goal reached: {ex.goal}", "bold #40e070")
