@@ -7,16 +7,21 @@ simulation itself never reads the wall clock.
 
 from __future__ import annotations
 
+import re
 import secrets
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from liansuo.interlocking.io import Result
+from liansuo.simulation.assessment import Assessment, ExerciseSetupError
+from liansuo.simulation.assessmentreport import write_report
+from liansuo.simulation.exercise import DIFFICULTIES, bundled_exercises, parse_exercise
 from liansuo.simulation.roles import INSTRUCTOR, refusal
 from liansuo.simulation.sim import Simulation
 from liansuo.simulation.snapshot import EventCursor, snapshot
 from liansuo.stations.library import bundled
+from liansuo.stations.source import StationError
 
 MAX_STEPS = 400  # cycles one seat may catch up in one advance: a stalled server does not freeze on its return
 
@@ -29,6 +34,8 @@ class Desk:
     paused: bool = False
     speed: float = 1.0
     debt: float = 0.0
+    assessment: Assessment | None = None  # the exercise being worked at this desk, scored
+    reported: list[Path] = field(default_factory=list)  # the reports written when it ended
 
 
 @dataclass
@@ -48,10 +55,26 @@ class Seat:
     def summary(self) -> dict[str, Any]:
         """What the instructor's dashboard shows of this seat."""
         d = self.desk
+        a = d.assessment
         return {"seat": self.number, "station": d.sim.station.id, "trainee": self.trainee,
                 "connected": self.connected, "t": d.sim.t, "paused": d.paused, "speed": d.speed,
                 "alarms": len(d.sim.alarm_views()), "refused": self.refused,
-                "commands": sum(w != INSTRUCTOR for _, w, *_ in self.log)}
+                "commands": sum(w != INSTRUCTOR for _, w, *_ in self.log),
+                "exercise": None if a is None else a.exercise.name,
+                "progress": None if a is None else a.progress(),
+                "score": None if a is None else a.progress()["score"],
+                "reports": [str(p) for p in d.reported]}
+
+    def briefing(self) -> dict[str, Any] | None:
+        """What the trainee at this seat is told of the exercise, and how it stands (no fault is named)."""
+        a = self.desk.assessment
+        if a is None:
+            return None
+        ex, p = a.exercise, a.progress()
+        return {"title": ex.title, "briefing": ex.briefing, "time_left_s": p["time_left_s"],
+                "goals": [{"description": g.description, "met": at is not None}
+                          for g, at in zip(ex.goals, a.goal_met_at, strict=True)],
+                "finished": p["finished"], "ended": p["ended"], "score": p["score"] if p["finished"] else None}
 
 
 class SeatError(ValueError):
@@ -59,14 +82,19 @@ class SeatError(ValueError):
 
 
 class Classroom:
-    def __init__(self, station: str, seats: int, *, cycle_s: float = 0.25, shared: bool = False) -> None:
+    def __init__(self, station: str, seats: int, *, cycle_s: float = 0.25, shared: bool = False,
+                 reports: Path | None = None, exercise_dirs: tuple[Path, ...] = ()) -> None:
         """``seats`` seats of ``station``: each with a simulation of its own, or all at one (``shared``: a team
-        exercise, where every seat operates the same station and its clock)."""
+        exercise, where every seat operates the same station and its clock). Reports of exercises go to
+        ``reports`` (``liansuo-reports`` in the working directory by default); exercises are the bundled ones and
+        those in ``exercise_dirs``."""
         if not 1 <= seats <= 64:
             raise SeatError(f"a classroom has 1 to 64 seats, not {seats}")
         self.station_ref = station
         self.cycle_s = cycle_s
         self.shared = shared
+        self.reports = reports or Path("liansuo-reports")
+        self.exercise_dirs = exercise_dirs
         team = Desk(Simulation(station, cycle_s=cycle_s)) if shared else None
         self.seats = {n: Seat(n, team or Desk(Simulation(station, cycle_s=cycle_s))) for n in range(1, seats + 1)}
 
@@ -90,7 +118,7 @@ class Classroom:
     def snapshot(self, seat: int, role: str, cursor: EventCursor) -> dict[str, Any]:
         s = self.seat(seat)
         data = snapshot(s.sim, role, cursor)
-        data.update(type="snapshot", seat=seat, paused=s.desk.paused, speed=s.desk.speed)
+        data.update(type="snapshot", seat=seat, paused=s.desk.paused, speed=s.desk.speed, exercise=s.briefing())
         return data
 
     def summaries(self) -> list[dict[str, Any]]:
@@ -109,7 +137,7 @@ class Classroom:
         if s.token and token != s.token:
             if s.connected:
                 raise SeatError(f"seat {number} is taken by {s.trainee or 'another trainee'}")
-            if s.trainee and trainee and trainee != s.trainee:
+            if s.trainee and trainee != s.trainee:
                 raise SeatError(f"seat {number} belongs to {s.trainee}, who may come back to it")
         if not s.token or token != s.token:
             s.token = secrets.token_hex(16)
@@ -133,6 +161,10 @@ class Classroom:
         result = no if no is not None else s.sim.command(line)
         if role != INSTRUCTOR and not result.ok:
             s.refused += 1
+        a = s.desk.assessment
+        if role != INSTRUCTOR and a is not None and not a.finished:
+            a.record(line, result)
+            self._report_if_ended(s.desk)
         s.log.append((s.sim.t, role, line, result.ok, result.message))
         return result
 
@@ -146,13 +178,87 @@ class Classroom:
                 d.speed = speed
 
     def reset(self, seats: list[int]) -> None:
-        """A fresh simulation of the station on each seat's desk; the seat keeps its trainee."""
+        """A fresh simulation of the station on each seat's desk, without exercise; the seat keeps its trainee."""
         for d in self.desks(seats):
-            d.sim.close()
-            d.sim, d.debt = Simulation(self.station_ref, cycle_s=self.cycle_s), 0.0
+            self._fresh(d, Simulation(self.station_ref, cycle_s=self.cycle_s))
+
+    def _fresh(self, d: Desk, sim: Simulation) -> None:
+        d.sim.close()
+        d.sim, d.debt, d.assessment, d.reported = sim, 0.0, None, []
         for s in self.seats.values():
-            if any(s.desk is d for d in self.desks(seats)):
+            if s.desk is d:
                 s.refused, s.log = 0, []
+
+    # ---- exercises --------------------------------------------------------------------------------------------
+    def exercise_names(self) -> list[str]:
+        return sorted({p.stem for p in self.exercise_files()})
+
+    def exercise_files(self) -> list[Path]:
+        return [*bundled_exercises(), *(p for d in self.exercise_dirs for p in sorted(d.glob("*.yaml")))]
+
+    def start_exercise(self, seats: list[int], name: str, *, difficulty: int | None = None,
+                       seed: int | None = None) -> str:
+        """Start exercise ``name`` afresh on these seats' desks: a new simulation, its setup and faults, and the
+        scoring. With ``seed`` every desk draws the same faults (a fair comparison); without, each its own."""
+        path = next((p for p in reversed(self.exercise_files()) if p.stem == name), None)
+        if path is None:
+            raise SeatError(f"no exercise '{name}' on this server; there are: {', '.join(self.exercise_names())}")
+        try:
+            ex = parse_exercise(path)
+        except StationError as exc:
+            raise SeatError(f"exercise '{name}' cannot be read: {exc.diagnostics[0] if exc.diagnostics else exc}"
+                            ) from None
+        if difficulty is not None and difficulty not in DIFFICULTIES:
+            raise SeatError(f"difficulty is 1 (easy), 2 (medium) or 3 (hard), not {difficulty}")
+        here = self.seat(min(self.seats)).sim.station.id
+        sims: list[Simulation] = []
+        made: list[tuple[Desk, Assessment]] = []
+        try:  # every desk's new simulation is made before any desk changes: a refusal changes nothing
+            for d in self.desks(seats):
+                sim = Simulation(ex.station_ref(), cycle_s=self.cycle_s)
+                sims.append(sim)
+                if sim.station.id != here:
+                    raise SeatError(f"exercise '{name}' is for station {sim.station.id}; this classroom serves "
+                                    f"{here}: start 'liansuo serve {ex.station}' for it")
+                who = [s for s in self.seats.values() if s.desk is d]
+                made.append((d, Assessment(ex, sim, seed=secrets.randbelow(10**6) if seed is None else seed,
+                                           trainee=", ".join(s.trainee for s in who if s.trainee),
+                                           seat=", ".join(str(s.number) for s in who), difficulty=difficulty)))
+        except (SeatError, ExerciseSetupError, StationError) as exc:
+            for sim in sims:
+                sim.close()
+            raise SeatError(str(exc)) from None
+        for d, a in made:
+            self._fresh(d, a.sim)
+            d.assessment = a
+        started = sorted(s.number for s in self.seats.values() if any(s.desk is d for d, _ in made))
+        return f"exercise '{ex.title}' started on seats {', '.join(map(str, started))}"
+
+    def stop_exercise(self, seats: list[int]) -> list[Path]:
+        """End the exercise on these seats' desks now, and write its reports (those already written stay)."""
+        out: list[Path] = []
+        for d in self.desks(seats):
+            if d.assessment is not None:
+                if not d.reported:
+                    d.reported = self._write(d)
+                out += d.reported
+        return out
+
+    def _report_if_ended(self, d: Desk) -> None:
+        if d.assessment is not None and d.assessment.finished and not d.reported:
+            d.reported = self._write(d)
+
+    def _write(self, d: Desk) -> list[Path]:
+        """One report per trainee at the desk (a team's desk: the team's attempt, under each name)."""
+        assert d.assessment is not None
+        report = d.assessment.report()
+        out: list[Path] = []
+        for s in self.seats.values():
+            if s.desk is d:
+                stem = _unused(self.reports, f"seat{s.number}-{_slug(s.trainee) or 'anonymous'}-"
+                                             f"{d.assessment.exercise.name}")
+                out += write_report({**report, "trainee": s.trainee, "seat": str(s.number)}, self.reports, stem)
+        return out
 
     def advance(self, wall_s: float) -> None:
         """Run every desk's clock on by ``wall_s`` seconds of the wall clock, at its speed."""
@@ -164,7 +270,25 @@ class Classroom:
             d.debt = min(d.debt - n * d.sim.cycle_s, d.sim.cycle_s)
             for _ in range(n):
                 d.sim.step()
+            if d.assessment is not None and not d.assessment.finished:
+                d.assessment.tick()
+                self._report_if_ended(d)
 
     def close(self) -> None:
         for d in self.desks():
             d.sim.close()
+
+
+def _slug(name: str) -> str:
+    """A trainee's name as part of a file name: letters (any script) and digits, joined by '-'."""
+    return "-".join(re.findall(r"\w+", name))[:40]
+
+
+def _unused(folder: Path, stem: str) -> str:
+    """``stem``, or ``stem-2``, ``stem-3``...: the first no report of the folder has (a second attempt keeps the
+    first's report)."""
+    n, out = 1, stem
+    while (folder / f"{out}.json").exists():
+        n += 1
+        out = f"{stem}-{n}"
+    return out

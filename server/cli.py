@@ -8,6 +8,7 @@ import getpass
 import socket
 import sys
 from collections.abc import Callable
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 from liansuo.stations.exitcodes import Exit, bad_input, refuse
@@ -26,6 +27,11 @@ def register(add: Add) -> None:
     sp.add_argument("--seats", type=int, default=2, metavar="N", help="trainee seats, 1 to 64 (default 2)")
     sp.add_argument("--shared", action="store_true",
                     help="a team exercise: every seat operates one simulation of the station, with one clock")
+    sp.add_argument("--reports", metavar="DIR", default="liansuo-reports",
+                    help="where each trainee's exercise report is written, JSON, text and HTML (default "
+                         "liansuo-reports)")
+    sp.add_argument("--exercise-dir", metavar="DIR", action="append", default=[],
+                    help="exercises the instructor may start besides the bundled ones (repeatable)")
     sp.add_argument("--host", default="127.0.0.1",
                     help="address to listen on (default 127.0.0.1: this machine only; 0.0.0.0 for a classroom)")
     sp.add_argument("--port", type=int, default=8765, metavar="P", help="port (default 8765; 0 picks a free one)")
@@ -61,11 +67,15 @@ def cmd_serve(args: argparse.Namespace) -> int:
         stored = instructor_hash(args.password_file)
     except PasswordError as exc:
         return refuse("serve", str(exc), Exit.USAGE)
+    missing = [d for d in args.exercise_dir if not Path(d).is_dir()]
+    if missing:
+        return refuse("serve", f"--exercise-dir {missing[0]}: no such directory", Exit.USAGE)
     from .classroom import Classroom, SeatError
     from .websocket import ClassroomServer
 
     try:
-        classroom = Classroom(args.station, args.seats, shared=args.shared)
+        classroom = Classroom(args.station, args.seats, shared=args.shared, reports=Path(args.reports),
+                              exercise_dirs=tuple(Path(d) for d in args.exercise_dir))
     except StationError as exc:
         return bad_input(exc)
     except SeatError as exc:

@@ -23,6 +23,13 @@ class Hello(_Message):
     password: str | None = Field(None, max_length=256, description="the instructor's password")
 
 
+class Lobby(_Message):
+    """Instead of a hello: what a login screen shows before anyone logs in (the station, the seats); then the
+    server closes the connection."""
+
+    type: Literal["lobby"]
+
+
 class Command(_Message):
     type: Literal["command"]
     id: int = Field(ge=0, le=2**53)
@@ -47,8 +54,22 @@ class Reset(_Message):
     seats: Seats
 
 
-Message = Annotated[Hello | Command | Watch | Clock | Reset, Field(discriminator="type")]
-MESSAGE: TypeAdapter[Hello | Command | Watch | Clock | Reset] = TypeAdapter(Message)
+class Exercise(_Message):
+    type: Literal["exercise"]
+    seats: Seats
+    name: str = Field(max_length=200, description="a bundled exercise, or one in the server's --exercise-dir")
+    difficulty: int | None = Field(None, ge=1, le=3, description="1 easy, 2 medium, 3 hard; else the exercise's own")
+    seed: int | None = Field(None, ge=0, le=2**31, description="the same seed draws the same faults on every seat")
+
+
+class Stop(_Message):
+    type: Literal["stop"]
+    seats: Seats
+
+
+ClientMessage = Hello | Lobby | Command | Watch | Clock | Reset | Exercise | Stop
+Message = Annotated[ClientMessage, Field(discriminator="type")]
+MESSAGE: TypeAdapter[ClientMessage] = TypeAdapter(Message)
 
 
 def problem(exc: Exception) -> str:

@@ -25,7 +25,7 @@ from liansuo.simulation.roles import INSTRUCTOR, TRAINEE
 from liansuo.simulation.snapshot import EventCursor
 
 from .classroom import Classroom, SeatError
-from .messages import MESSAGE, Clock, Command, Hello, Reset, Watch, problem
+from .messages import MESSAGE, ClientMessage, Clock, Command, Exercise, Hello, Lobby, Stop, Watch, problem
 
 TICK_S = 0.05  # the clocks' pace on the wall clock
 PUSH_S = 0.25  # a snapshot to each client this often
@@ -87,6 +87,10 @@ class ClassroomServer:
         try:
             raw = await asyncio.wait_for(ws.recv(), HELLO_TIMEOUT_S)
             hello = MESSAGE.validate_json(raw)
+            if isinstance(hello, Lobby):
+                await ws.send(json.dumps(self.lobby()))
+                await ws.close(1000, "lobby")
+                return None
             if not isinstance(hello, Hello):
                 raise SeatError("the first message is a hello: {\"type\": \"hello\", \"role\": ...}")
             client = self.admit(hello)
@@ -100,6 +104,13 @@ class ClassroomServer:
                                   "station": self.classroom.station_source(), "cycle_s": seat.sim.cycle_s,
                                   "seats": len(self.classroom.seats)}))
         return client
+
+    def lobby(self) -> dict[str, Any]:
+        """What a login screen shows: the station and who sits where (no token, nothing of any seat's state)."""
+        room = self.classroom
+        return {"type": "lobby", "station": room.station_source(), "cycle_s": room.cycle_s, "shared": room.shared,
+                "seats": [{"seat": s.number, "trainee": s.trainee, "connected": s.connected}
+                          for s in room.seats.values()]}
 
     def admit(self, hello: Hello) -> Client:
         if hello.role == INSTRUCTOR:
@@ -135,10 +146,10 @@ class ClassroomServer:
             traceback.print_exc(file=sys.stderr)
             return {"type": "error", "message": "internal error on the server (reported in its log)"}
 
-    def dispatch(self, client: Client, msg: Hello | Command | Watch | Clock | Reset) -> dict[str, Any]:
+    def dispatch(self, client: Client, msg: ClientMessage) -> dict[str, Any]:
         instructor = client.role == INSTRUCTOR
-        if isinstance(msg, Hello):
-            raise SeatError("a hello is sent once, first")
+        if isinstance(msg, Hello | Lobby):
+            raise SeatError(f"a {msg.type} is sent once, first")
         if isinstance(msg, Command):
             if msg.seat is not None and msg.seat != client.seat and not instructor:
                 raise SeatError("a trainee operates only their own seat")
@@ -157,6 +168,14 @@ class ClassroomServer:
             self.classroom.set_clock(seats, paused=paused, speed=msg.speed)
             return {"type": "ok", "message": f"clock of seats {', '.join(map(str, seats))}: "
                                              f"{msg.action or 'speed'} {'' if msg.speed is None else msg.speed}"}
+        if isinstance(msg, Exercise):
+            said = self.classroom.start_exercise(seats, msg.name, difficulty=msg.difficulty, seed=msg.seed)
+            client.cursor = EventCursor()
+            return {"type": "ok", "message": said}
+        if isinstance(msg, Stop):
+            written = self.classroom.stop_exercise(seats)
+            return {"type": "ok", "message": f"reports written: {', '.join(str(p) for p in written)}" if written
+                    else "no exercise on those seats", "reports": [str(p) for p in written]}
         self.classroom.reset(seats)
         client.cursor = EventCursor()
         return {"type": "ok", "message": f"seats {', '.join(map(str, seats))} reset"}

@@ -48,8 +48,8 @@ def test_a_trainee_cannot_send_the_instructors_commands(url: str) -> None:
 
 
 def test_an_injected_fault_never_reaches_the_other_seat_nor_the_faulted_trainees_log(url: str) -> None:
-    with ClassroomClient.instructor(url, PASSWORD) as teacher, \
-            ClassroomClient.trainee(url, seat=1, name="Li") as li, ClassroomClient.trainee(url, seat=2) as wang:
+    with ClassroomClient.instructor(url, PASSWORD) as teacher, ClassroomClient.trainee(url, seat=1, name="Li") as li, \
+            ClassroomClient.trainee(url, seat=2, name="Wang") as wang:
         assert teacher.command("fault broken-rail IG", seat=1)["ok"]
         time.sleep(1.0)
         for _ in range(4):
@@ -78,6 +78,8 @@ def test_a_seat_is_taken_back_with_its_token_and_by_nobody_else(url: str) -> Non
     time.sleep(0.3)
     with pytest.raises(ClassroomError, match="belongs to Zhao"):
         ClassroomClient.trainee(url, seat=3, name="Qian")
+    with pytest.raises(ClassroomError, match="belongs to Zhao"):
+        ClassroomClient.trainee(url, seat=3)  # nor by a client that gives no name
     with pytest.raises(ClassroomError, match="no seat 4"):
         ClassroomClient.trainee(url, seat=4)
     with ClassroomClient.trainee(url, seat=3, name="Zhao", token=token) as back:
@@ -86,7 +88,7 @@ def test_a_seat_is_taken_back_with_its_token_and_by_nobody_else(url: str) -> Non
 
 
 def test_bad_messages_get_an_error_reply_and_the_server_carries_on(url: str) -> None:
-    with ClassroomClient.trainee(url, seat=2) as c:
+    with ClassroomClient.trainee(url, seat=2, name="Wang") as c:
         for raw in ("{", "[]", '{"type": "command"}', '{"type": "command", "id": -1, "line": "x"}',
                     '{"type": "clock", "seats": "all", "action": "pause"}', '{"type": "hello", "role": "trainee"}',
                     json.dumps({"type": "command", "id": 1, "line": "route " + "X" * 5000}), '"\\u0000"'):
