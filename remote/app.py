@@ -18,12 +18,14 @@ from rich.text import Text
 from textual.binding import Binding, BindingType
 
 from liansuo.simulation.roles import INSTRUCTOR
+from liansuo.stations.printable import printable
 from liansuo.tui.app import SPEEDS, ConsoleApp
 from liansuo.tui.instructor import InstructorPanel
 
 from .dashboard import DashboardScreen, ExerciseChoice, ExercisePicker
-from .link import Link
-from .sim import LOST, RemoteSimulation
+from .link import Link, Unlinked
+from .login import LoginScreen
+from .sim import LOST, NOT_IN, RemoteSimulation
 
 
 class RemoteConsoleApp(ConsoleApp):
@@ -34,7 +36,8 @@ class RemoteConsoleApp(ConsoleApp):
         Binding("f3", "dashboard", "seats", key_display="F3"),
     ]
 
-    def __init__(self, link: Link, *, mute: bool = False) -> None:
+    def __init__(self, link: Link | Unlinked, *, mute: bool = False) -> None:
+        """On a seat through ``link``; or, :class:`Unlinked`, the login screen first over the station drawn dark."""
         self.link = link
         self.remote = RemoteSimulation(link)
         super().__init__(self.remote.station.id, sim=self.remote, mute=mute)
@@ -42,6 +45,12 @@ class RemoteConsoleApp(ConsoleApp):
         self.warm_up = False
         self._generation = link.generation
         self._was_live = True
+        self._lesson: tuple[str, str] | None = None  # the exercise last shown (title, briefing)
+        self._lesson_ended = False
+
+    @property
+    def logged_in(self) -> bool:
+        return isinstance(self.link, Link)
 
     @property
     def seat(self) -> int:
@@ -50,7 +59,26 @@ class RemoteConsoleApp(ConsoleApp):
     def started(self) -> None:
         self.remote.step()
         self.refresh_views()
-        if self.instructor:
+        if not isinstance(self.link, Link):
+            self.push_screen(LoginScreen(self.link.url, self.link.lobby), self.logged)
+            return
+        self.greet()
+
+    def logged(self, link: Link | None) -> None:
+        """The login screen's link: the console now shows and operates that seat (or the instructor's)."""
+        if link is None:
+            self.exit()
+            return
+        self.link = link
+        self.remote.attach(link)
+        self.instructor = link.role == INSTRUCTOR
+        self._generation, self._was_live = link.generation, True
+        self.remote.step()
+        self.refresh_views()
+        self.greet()
+
+    def greet(self) -> None:
+        if self.instructor and isinstance(self.link, Link):
             self.say(f"seat {self.seat}: every command goes to this seat; F3 the seats, F2 faults and trains")
             self.push_screen(DashboardScreen(self.link))
         else:
@@ -66,16 +94,37 @@ class RemoteConsoleApp(ConsoleApp):
             self.remote.step()
             self.paused, self.speed = self.remote.paused, self.remote.speed
             live = self.link.connected
+            if not self.logged_in:
+                self.refresh_views()
+                return
             if live != self._was_live or self._generation != self.link.generation:
                 self._was_live, self._generation = live, self.link.generation
                 self.say(f"{LOST}: the diagram shows nothing until it is back" if not live
                          else f"connection to the classroom server back: seat {self.seat}", live)
                 self.log_panel.add(f"{self.remote.t:9.2f} {'link':8} {'lost' if not live else 'back'}",
                                    "#ff6060" if not live else "#80ff80")
+            self.follow_lesson()
             self.refresh_views()
         except Exception as exc:  # no traceback on the screen
             incident = self.report_unexpected(exc, "the classroom link")
             self.say(f"internal error: {incident.summary} (see the alarms)", False)
+
+    def follow_lesson(self) -> None:
+        """An exercise started on the seat: its briefing and goals in the log; ended: how, and the score."""
+        lesson = self.remote.lesson
+        key = None if lesson is None else (lesson["title"], lesson["briefing"])
+        if key != self._lesson:
+            self._lesson, self._lesson_ended = key, False
+            if lesson is not None:
+                self.log_panel.add(printable(f"{self.remote.t:9.2f} {'lesson':8} {lesson['title']}: "
+                                             f"{' '.join(str(lesson['briefing']).split())}"), "#d0a0ff")
+                for g in lesson["goals"]:
+                    self.log_panel.add(printable(f"{'':9} {'goal':8} {g['description']}"), "#d0a0ff")
+                self.say(f"exercise: {lesson['title']} (the briefing is in the event log)", True)
+        if lesson is not None and lesson["finished"] and not self._lesson_ended:
+            self._lesson_ended = True
+            self.log_panel.add(printable(f"{self.remote.t:9.2f} {'lesson':8} {lesson_text(lesson)}"),
+                               "bold #40e070")
 
     def _clock(self, **what: Any) -> None:
         if not self.instructor:
@@ -110,7 +159,7 @@ class RemoteConsoleApp(ConsoleApp):
         return ""
 
     def action_dashboard(self) -> None:
-        if not self.instructor:
+        if not self.instructor or not isinstance(self.link, Link):
             self.say("the seats' dashboard is the instructor's", False)
             return
         if not isinstance(self.screen, DashboardScreen):
@@ -142,6 +191,22 @@ class RemoteConsoleApp(ConsoleApp):
     def status_text(self, alarms: int) -> Text:
         out = super().status_text(alarms)
         out.append(f"│ seat {self.seat} ", style="bold")
-        if not self.link.connected:
+        lesson = self.remote.lesson
+        if lesson is not None:
+            done = bool(lesson["finished"])
+            out.append(printable(f"│ {lesson_text(lesson)} "), style="bold #40e070" if done else "#ffd700")
+        if not self.logged_in:
+            out.append(f"│ {NOT_IN} ", style="bold #ffffff on #c00000")
+        elif not self.link.connected:
             out.append(f"│ {LOST} ", style="bold #ffffff on #c00000")
         return out
+
+
+def lesson_text(lesson: dict[str, Any]) -> str:
+    """An exercise as the status line says it: 'Cancel a wrong route: 1/2 goals, 03:12 left' or, ended, how and
+    the score."""
+    met = sum(bool(g["met"]) for g in lesson["goals"])
+    if lesson["finished"]:
+        return f"{lesson['title']}: {lesson['ended']}, {met}/{len(lesson['goals'])} goals, score {lesson['score']}"
+    left = float(lesson["time_left_s"])
+    return f"{lesson['title']}: {met}/{len(lesson['goals'])} goals, {int(left // 60):02d}:{int(left % 60):02d} left"

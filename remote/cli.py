@@ -55,7 +55,7 @@ def hello(args: argparse.Namespace) -> dict[str, Any] | None:
 def cmd_connect(args: argparse.Namespace) -> int:
     from liansuo.tui.cli import closed
 
-    from .link import Link, LinkError
+    from .link import Link, LinkError, Unlinked, lobby
 
     try:
         greeting = hello(args)
@@ -63,18 +63,11 @@ def cmd_connect(args: argparse.Namespace) -> int:
             raise LoginError(f"--connect takes a websocket address, ws://HOST:PORT, not {args.connect!r}")
     except LoginError as exc:
         return refuse("tui", str(exc), Exit.USAGE)
-    if greeting is None:
-        from .login import LoginApp
-
-        login = LoginApp(args.connect)
-        link = login.run()
-        if link is None:  # closed without logging in
-            return 0
-    else:
-        try:
-            link = Link(args.connect, greeting)
-        except LinkError as exc:
-            return refuse("tui", str(exc), Exit.USAGE)
+    try:
+        link: Link | Unlinked = Unlinked(args.connect, lobby(args.connect)) if greeting is None \
+            else Link(args.connect, greeting)
+    except LinkError as exc:
+        return refuse("tui", str(exc), Exit.USAGE)
     from .app import RemoteConsoleApp
 
     app = RemoteConsoleApp(link, mute=args.mute)

@@ -197,3 +197,54 @@ class Link:
                 self.connected, self.problem = True, ""
                 self.generation += 1
             return
+
+
+def lobby(url: str, timeout: float = OPEN_TIMEOUT_S) -> dict[str, Any]:
+    """What the server tells before a login: its station, cycle and seats (who sits where); :class:`LinkError`
+    when it cannot be asked."""
+    try:
+        with connect(url, open_timeout=timeout, close_timeout=1) as ws:
+            ws.send(json.dumps({"type": "lobby"}))
+            reply = json.loads(ws.recv(timeout=timeout))
+    except (InvalidURI, ValueError) as exc:
+        raise LinkError(f"{url} is not a websocket address (ws://HOST:PORT): {exc}") from None
+    except (OSError, TimeoutError, WebSocketException) as exc:
+        raise LinkError(f"cannot reach the classroom server at {url}: {exc}") from None
+    if not isinstance(reply, dict) or reply.get("type") != "lobby":
+        why = reply.get("message", reply) if isinstance(reply, dict) else reply
+        raise LinkError(f"the classroom server at {url} did not answer as one: {why}")
+    return reply
+
+
+class Unlinked:
+    """A console not logged in yet: it has the station from the lobby to draw (dark, as with no inputs), and
+    answers every request that it is not logged in. It stands where a :class:`Link` will."""
+
+    connected = False
+    generation = 0
+    role = "trainee"
+    seat = 0
+    problem = "not logged in"
+
+    def __init__(self, url: str, lobby: dict[str, Any]) -> None:
+        self.url = url
+        self.lobby = lobby
+        self.welcome = {"station": lobby.get("station") or {}, "cycle_s": lobby.get("cycle_s", 0.25)}
+
+    def take(self) -> tuple[dict[str, Any] | None, list[list[Any]]]:
+        return None, []
+
+    def seats(self) -> list[dict[str, Any]]:
+        return []
+
+    def request(self, message: dict[str, Any]) -> dict[str, Any]:
+        return {"type": "error", "message": "not logged in to the classroom yet: nothing was sent"}
+
+    def command(self, line: str, seat: int | None = None) -> dict[str, Any]:
+        return self.request({})
+
+    def watch(self, seat: int) -> dict[str, Any]:
+        return self.request({})
+
+    def close(self) -> None:
+        pass

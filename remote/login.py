@@ -1,6 +1,9 @@
 """The login of a classroom client started without ``--seat`` or ``--instructor`` (as a browser's, served by
 textual-serve, always is): a trainee gives a name and a seat, the instructor the password. The connection is tried
-from the form, and a refusal (seat taken, wrong password) is shown there to be corrected."""
+from the form, and a refusal (seat taken, wrong password) is shown there to be corrected.
+
+It is a screen of the console itself, over the station drawn dark (the server's lobby names the station), not an
+app of its own: textual-serve ends a browser's session when its process's first app exits."""
 
 from __future__ import annotations
 
@@ -8,9 +11,10 @@ from typing import Any, ClassVar
 
 from rich.text import Text
 from textual import work
-from textual.app import App, ComposeResult
+from textual.app import ComposeResult
 from textual.binding import Binding, BindingType
 from textual.containers import Vertical
+from textual.screen import ModalScreen
 from textual.widgets import Button, Input, Label, RadioButton, RadioSet, Static
 
 from liansuo.stations.printable import printable
@@ -29,24 +33,37 @@ def hello_of(role: str, name: str, seat: str, password: str) -> dict[str, Any] |
     return {"role": "trainee", "seat": int(seat), "name": name.strip()[:64]}
 
 
-class LoginApp(App[Link]):
-    """The login form; it exits with the open link."""
+def seats_text(lobby: dict[str, Any]) -> str:
+    """Who sits where, as the login screen lists it: '1 Li Lei · 2 free · 3 Wang (away)'."""
+    out = []
+    for s in lobby.get("seats", []):
+        who = str(s.get("trainee") or "")
+        out.append(f"{s.get('seat')} {who or 'free'}{' (away)' if who and not s.get('connected') else ''}")
+    return " · ".join(out)
 
-    TITLE = "liansuo 联锁 classroom"
-    CSS = """
-    Screen { align: center middle; background: #0c0f12; }
-    #form { width: 60; height: auto; border: round #80d0ff; padding: 0 1; }
-    #why { height: auto; }
+
+class LoginScreen(ModalScreen[Link | None]):
+    """The login form over the station drawn dark; it is dismissed with the open link (None: the console closes)."""
+
+    DEFAULT_CSS = """
+    LoginScreen { align: center middle; }
+    LoginScreen #form { width: 64; height: auto; border: round #80d0ff; padding: 0 1; background: #0c0f12; }
+    LoginScreen #why { height: auto; }
+    LoginScreen #seats, LoginScreen #where { height: auto; color: #a0a0a0; }
     """
-    BINDINGS: ClassVar[list[BindingType]] = [Binding("ctrl+q", "quit", "quit")]
+    BINDINGS: ClassVar[list[BindingType]] = [Binding("ctrl+q", "leave", "quit")]
 
-    def __init__(self, url: str) -> None:
+    def __init__(self, url: str, lobby: dict[str, Any]) -> None:
         super().__init__()
         self.url = url
+        self.lobby = lobby
 
     def compose(self) -> ComposeResult:
+        station = str((self.lobby.get("station") or {}).get("name", ""))
         with Vertical(id="form"):
-            yield Label(f"登录 Log in to the classroom at {printable(self.url)}")
+            yield Label("登录 Log in to the classroom")
+            yield Static(printable(f"{self.url} · station {station}"), id="where")
+            yield Static(printable(f"seats: {seats_text(self.lobby)}"), id="seats")
             with RadioSet(id="role"):
                 yield RadioButton("值班员 trainee", value=True, id="trainee")
                 yield RadioButton("教员 instructor", id="instructor")
@@ -55,6 +72,9 @@ class LoginApp(App[Link]):
             yield Input(placeholder="password (instructor)", id="password", password=True)
             yield Button("Connect", id="connect", variant="primary")
             yield Static(id="why")
+
+    def on_mount(self) -> None:
+        self.query_one("#name", Input).focus()  # most who log in are trainees: they type their name first
 
     def role(self) -> str:
         pressed = self.query_one(RadioSet).pressed_button
@@ -65,6 +85,9 @@ class LoginApp(App[Link]):
 
     def on_button_pressed(self, event: Button.Pressed) -> None:
         self.connect()
+
+    def action_leave(self) -> None:
+        self.dismiss(None)
 
     def connect(self) -> None:
         hello = hello_of(self.role(), self.query_one("#name", Input).value, self.query_one("#seat", Input).value,
@@ -80,9 +103,9 @@ class LoginApp(App[Link]):
         try:
             link = Link(self.url, hello)
         except LinkError as exc:
-            self.call_from_thread(self.show, str(exc))
+            self.app.call_from_thread(self.show, str(exc))
             return
-        self.call_from_thread(self.exit, link)
+        self.app.call_from_thread(self.dismiss, link)
 
     def show(self, text: str, bad: bool | None = True) -> None:
         style = "#e0e0e0" if bad is None else "bold #ff5050"

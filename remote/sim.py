@@ -25,9 +25,10 @@ from liansuo.simulation.view import AlarmView, TrainView
 from liansuo.stations.loader import load, load_text
 from liansuo.stations.station import Station
 
-from .link import Link
+from .link import Link, Unlinked
 
 LOST = "connection to the classroom server lost, reconnecting"
+NOT_IN = "not logged in to the classroom yet"
 MAX_EVENTS = 20_000
 
 
@@ -87,7 +88,7 @@ def load_station(source: dict[str, Any], rules: RuleSet) -> Station:
     return load(str(source["name"]), rules=rules)
 
 
-def dark(station: Station, t: float) -> dict[str, Any]:
+def dark(station: Station, t: float, why: str = LOST) -> dict[str, Any]:
     """The snapshot of a station whose inputs are lost: sections occupied, turnouts without indication, lamps dark,
     no route, doors not shown closed and locked."""
     return {
@@ -102,7 +103,7 @@ def dark(station: Station, t: float) -> dict[str, Any]:
         "doors": {f"{p.id}:{d.side.value}": "open" for p in station.model.platforms for d in p.screen_doors},
         "lines": {lk.id: None for lk in station.model.links},
         "trains": [],
-        "alarms": [{"key": "link", "kind": "link", "element": "", "text": LOST, "t": None}],
+        "alarms": [{"key": "link", "kind": "link", "element": "", "text": why, "t": None}],
         "events": [],
     }
 
@@ -112,7 +113,7 @@ class RemoteSimulation:
 
     language: Language[Simulation] = LANGUAGE  # for completion: the same words the server's simulation reads
 
-    def __init__(self, link: Link) -> None:
+    def __init__(self, link: Link | Unlinked) -> None:
         self.link = link
         self.rules: RuleSet = load_rules()
         self.station: Station = load_station(dict(link.welcome.get("station") or {}), self.rules)
@@ -126,9 +127,12 @@ class RemoteSimulation:
         self.live = False  # showing the server's state (False: the fail-safe picture, or nothing received yet)
         self.seat = link.seat
         self._log: deque[Event] = deque(maxlen=MAX_EVENTS)
-        self._generation = link.generation
-        self._show(dark(self.station, 0.0))
+        self._show(dark(self.station, 0.0, LOST if isinstance(link, Link) else NOT_IN))
         self.live = False
+
+    def attach(self, link: Link) -> None:
+        """Logged in: the seat's state from now on comes through ``link``."""
+        self.link, self.seat = link, link.seat
 
     @property
     def t(self) -> float:
@@ -137,6 +141,7 @@ class RemoteSimulation:
     def _show(self, data: dict[str, Any]) -> None:
         self.view = LiveView(self.station.id, data, self._log)
         self.field = RemoteField(self.view)
+        self.lesson: dict[str, Any] | None = data.get("exercise")  # what the trainee is told of the exercise
         self.paused = bool(data.get("paused", self.paused))
         self.speed = float(data.get("speed", self.speed))
         self.live = True

@@ -70,18 +70,23 @@ class Browser:
     def evaluate(self, expression: str) -> Any:
         return self.call("Runtime.evaluate", expression=expression, returnByValue=True).get("result", {}).get("value")
 
+    def focus(self, selector: str) -> None:
+        """Give the keyboard to the element ``selector`` (a terminal page's hidden text area)."""
+        self.evaluate(f"document.querySelector({json.dumps(selector)})?.focus()")
+
     def type(self, text: str) -> None:
-        """Type text as keys, one character at a time (a terminal page reads key events)."""
+        """Type text as a keyboard does, one character at a time."""
         for ch in text:
-            self.call("Input.dispatchKeyEvent", type="keyDown", text=ch, key=ch, unmodifiedText=ch)
-            self.call("Input.dispatchKeyEvent", type="keyUp", key=ch)
-            time.sleep(0.02)
+            self.call("Input.insertText", text=ch)
+            time.sleep(0.03)
 
     def press(self, name: str) -> None:
         key, code, vk = KEYS[name]
-        extra = {"text": "\r"} if name == "Enter" else {}
-        self.call("Input.dispatchKeyEvent", type="keyDown", key=key, code=code, windowsVirtualKeyCode=vk, **extra)
+        self.call("Input.dispatchKeyEvent", type="rawKeyDown", key=key, code=code, windowsVirtualKeyCode=vk)
+        if name == "Enter":
+            self.call("Input.dispatchKeyEvent", type="char", text="\r", key=key, code=code, windowsVirtualKeyCode=vk)
         self.call("Input.dispatchKeyEvent", type="keyUp", key=key, code=code, windowsVirtualKeyCode=vk)
+        time.sleep(0.05)
 
     def screenshot(self, path: Path) -> None:
         data = self.call("Page.captureScreenshot", format="png")["data"]

@@ -9,6 +9,7 @@ import asyncio
 import functools
 import threading
 from collections.abc import Awaitable, Callable, Iterator
+from pathlib import Path
 from typing import Any
 
 import pytest
@@ -31,8 +32,8 @@ SIZE = (120, 36)
 class Server:
     """A classroom server in a thread of its own, stopped and started again on the same port at will."""
 
-    def __init__(self, seats: int = 2) -> None:
-        self.classroom = Classroom("jiaopei", seats)
+    def __init__(self, seats: int = 2, reports: Path | None = None) -> None:
+        self.classroom = Classroom("jiaopei", seats, reports=reports)
         self.server = ClassroomServer(self.classroom, hash_password(PASSWORD))
         self.loop = asyncio.new_event_loop()
         self.thread = threading.Thread(target=self.loop.run_forever, daemon=True)
@@ -68,8 +69,8 @@ class Server:
 
 
 @pytest.fixture
-def server() -> Iterator[Server]:
-    s = Server()
+def server(tmp_path: Path) -> Iterator[Server]:
+    s = Server(reports=tmp_path / "reports")
     try:
         yield s
     finally:
@@ -254,24 +255,48 @@ def test_a_wrong_password_or_a_taken_seat_ends_the_client_with_status_2(
 
 
 @run
-async def test_the_login_screen_asks_again_after_a_refusal_then_connects(server: Server) -> None:
-    from textual.widgets import Input, RadioButton, Static
+async def test_the_login_screen_lists_the_seats_asks_again_after_a_refusal_then_connects(server: Server) -> None:
+    from textual.widgets import Input, Static
 
-    from liansuo.remote.login import LoginApp
+    from liansuo.remote.link import Unlinked, lobby
+    from liansuo.remote.login import LoginScreen
 
-    app = LoginApp(server.url)
+    with ClassroomClient.trainee(server.url, seat=2, name="Wang"):
+        app = RemoteConsoleApp(Unlinked(server.url, lobby(server.url)))
+        async with app.run_test(size=SIZE) as pilot:
+            await pilot.pause()
+            login = app.screen
+            assert isinstance(login, LoginScreen)
+            assert "1 free · 2 Wang" in str(login.query_one("#seats", Static).content)
+            assert band(app, "IG") == BAND_COLOUR["occupied"]  # the station drawn dark until logged in
+            await pilot.press(*"Li", "tab", "2", "enter")  # name, seat 2: Wang's
+            why = login.query_one("#why", Static)
+            await until(pilot, lambda: "seat 2 is taken by Wang" in str(why.content))
+            login.query_one("#seat", Input).value = ""
+            await pilot.click("#seat")
+            await pilot.press("1", "enter")
+            await until(pilot, lambda: app.logged_in and app.remote.live and band(app, "IG") == BAND_COLOUR["free"])
+            assert not isinstance(app.screen, LoginScreen) and app.seat == 1
+            await type_line(pilot, "route X XI")
+            assert "✓" in message(app), message(app)
+            assert server.classroom.seat(1).trainee == "Li"
+
+
+@run
+async def test_a_trainee_reads_the_exercise_started_on_the_seat_and_its_score_at_the_end(server: Server) -> None:
+    app = RemoteConsoleApp(Link(server.url, {"role": "trainee", "seat": 1, "name": "Li"}))
     async with app.run_test(size=SIZE) as pilot:
         await pilot.pause()
-        await pilot.click(RadioButton, offset=(2, 0))  # the first: trainee, already
-        await pilot.click("#instructor")
-        app.query_one("#password", Input).value = "wrong horse"
-        await pilot.click("#connect")
-        why = app.query_one("#why", Static)
-        await until(pilot, lambda: "wrong instructor password" in str(why.content))
-        app.query_one("#password", Input).value = ""
-        await pilot.click("#password")
-        await pilot.press(*[{" ": "space"}.get(c, c) for c in PASSWORD], "enter")  # typed, and Enter connects
-        await until(pilot, lambda: app.return_value is not None)
-    link = app.return_value
-    assert link is not None and link.role == "instructor"
-    link.close()
+        with ClassroomClient.instructor(server.url, PASSWORD) as teacher:
+            reply = teacher.request({"type": "exercise", "seats": [1], "name": "jiaopei-cancel-route", "seed": 1})
+            assert reply["type"] == "ok", reply
+        await until(pilot, lambda: "Cancel a wrong route" in str(app.status_bar.content))
+        assert "0/2 goals" in str(app.status_bar.content) and "left" in str(app.status_bar.content)
+        assert "dispatcher wants the train on the main track IG" in log(app)  # the briefing, in the event log
+        await until(pilot, lambda: band(app, "3G") == BAND_COLOUR["locked"])  # the setup's route X-X3
+        await type_line(pilot, "cancel X")
+        await until(pilot, lambda: band(app, "3G") == BAND_COLOUR["free"])
+        await type_line(pilot, "route X XI")
+        await until(pilot, lambda: "goals met" in str(app.status_bar.content), 12)
+        assert "score" in log(app) and "2/2 goals" in str(app.status_bar.content)
+    assert [p.suffix for p in server.classroom.seat(1).desk.reported] == [".json", ".txt", ".html"]
