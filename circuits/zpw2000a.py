@@ -3,12 +3,14 @@
 One section of ``length_m`` is a uniform two-rail line (series rail impedance, shunt ballast conductance) between a
 transmitter end (发送端) and a receiver end (接收端), solved exactly with chain (ABCD) matrices:
 
-    transmitter: EMF ``transmitter_V / matching_ratio`` behind ``source_ohm / matching_ratio**2`` (transmitter
-                 output, cable and matching transformer referred to the rails), in parallel with the tuning area
+    transmitter: the transmitter (EMF ``transmitter_V`` behind ``source_ohm``) through ``cable_km`` of cable and
+                 the matching transformer, referred to the rails, in parallel with the tuning area (:mod:`.zpwends`)
     line:        exact uniform-line two-ports (cosh / sinh of gamma*l) between the compensation capacitors
                  (补偿电容, shunt admittances across the rails) and wheelset shunts (shunt conductances)
-    receiver:    the tuning area in parallel with the receiver load (matching transformer, cable, receiver),
+    receiver:    the tuning area in parallel with the receiver seen through its cable and matching transformer,
                  rail voltage times the receiver gain = main-track output voltage (主轨出) in mV
+    small track: the tuning area at the transmitter end; its far side's rail voltage times its own gain is what
+                 the neighbour's receiver checks (小轨道, ``ZpwCircuit.small_track_mV``)
 
 The transmitter is at the section's upper end and the receiver at its lower end (``transmitter_end="upper"``), as
 for a down train: in ZPW-2000A the signal runs against the traffic, from the end the train leaves towards, so a
@@ -33,7 +35,9 @@ from typing import TYPE_CHECKING, Any, Literal
 import numpy as np
 import numpy.typing as npt
 
+from . import zpwends
 from .physical import check_ballast, check_position, check_shunts
+from .zpwends import Ends
 
 if TYPE_CHECKING:
     from liansuo.stations.station import Station
@@ -75,13 +79,25 @@ class ZpwParams:
     capacitor_spacing_m: float = 100.0  # TB/T 3206: about every 100 m, half a spacing at the ends
     capacitor_min_section_m: float = 300.0  # Luo Ying 2023 (docs/references.md): only sections over 300 m
     capacitor_short_ohm: float = 0.01  # a shorted capacitor (modelled)
-    # transmitter end (typical: level-1 output 161-170 V, 1:9 matching transformer; impedances modelled)
+    # transmitter and receiver (typical: level-1 output 161-170 V, 1:9 matching transformer; impedances modelled)
     transmitter_V: float = 170.0  # the level in use (the adjustment table chooses it: circuits/zpwadjust.py)
     transmitter_levels_V: tuple[float, float, float, float, float] = (170.0, 154.0, 135.0, 111.5, 79.5)  # levels 1-5
     matching_ratio: float = 9.0  # equipment side : rail side
-    source_ohm: complex = complex(300.0, 0.0)  # transmitter output + cable, equipment side
-    receiver_ohm: complex = complex(800.0, 0.0)  # receiver input + cable, equipment side
-    tuning_ohm: complex = complex(2.0, 0.5)  # the tuning area at the section's own carrier, rail side (modelled)
+    source_ohm: complex = complex(10.0, 0.0)  # transmitter output impedance, equipment room (modelled)
+    receiver_ohm: complex = complex(800.0, 0.0)  # receiver input impedance, equipment room (modelled)
+    # cable between the equipment room and the track (SPT signalling cable, 1.0 mm conductors, a pair; TB/T 3100,
+    # verify): the ZPW-2000A cable simulation network pads every cable to the standard 10 km
+    cable_km: float = 10.0
+    cable_ohm_km: float = 47.0  # loop resistance (2 x 23.5 ohm/km)
+    cable_mH_km: float = 0.75
+    cable_nF_km: float = 28.0
+    # tuning areas (circuits/zpwends.py): 29 m electrical insulation joint, air-core coil, tuning units designed
+    # for the zero at the neighbour's carrier and the pole at the own one
+    tuning_units: bool = True  # False: insulated joints at both ends, no tuning area across the rails
+    tuning_area_m: float = 29.0
+    air_core_uH: float = 33.5
+    tuning_q: float = 30.0  # quality factor of the air-core coil and the tuning units' inductors (modelled)
+    f2_inductance_uH: float = 100.0  # L2 of the 2300 / 2600 Hz units: not fixed by the two resonances (modelled)
     # receiver (维规 TG/XH 101-2015, docs/references.md: pick-up about 200-210 mV, drop 153 mV; verify)
     pickup_mV: float = 210.0
     drop_mV: float = 153.0
@@ -116,22 +132,10 @@ class ZpwParams:
     def cab_min(self, carrier: str) -> float:
         return self.cab_min_mA[_base_index(carrier)]
 
-    @property
-    def emf_V(self) -> float:
-        return self.transmitter_V / self.matching_ratio
-
-    @property
-    def source_rail_ohm(self) -> complex:
-        return self.source_ohm / self.matching_ratio**2
-
-    @property
-    def tx_end_S(self) -> complex:
-        return 1 / self.tuning_ohm
-
-    @property
-    def rx_end_S(self) -> complex:
-        return 1 / self.tuning_ohm + self.matching_ratio**2 / self.receiver_ohm
-
+    def ends(self, carrier: str, ballast: float | None = None) -> Ends:
+        """Both ends of a section at its carrier, referred to the rails (:mod:`.zpwends`)."""
+        b = self.ballast_ohm_km if ballast is None else ballast
+        return zpwends.ends(self, carrier, carrier_frequency_Hz(carrier), b)
 
 DEFAULT_PARAMS = ZpwParams()
 
@@ -167,16 +171,18 @@ def capacitor_positions(station: Station, section_id: str, params: ZpwParams = D
 # ---- the vectorised solver -----------------------------------------------------------------------------------------
 def solve(length_m: float, capacitors_s: Sequence[float], ycap: CArray, shunts_s: Sequence[float] | FArray,
           z_km: CArray, ballasts: Sequence[float], params: ZpwParams = DEFAULT_PARAMS, *,
-          shunt_ohm: float | None = None, breaks_s: Sequence[float] = (), rx_extra_S: complex = 0j,
-          ) -> tuple[CArray, CArray, CArray]:
+          ends: Sequence[Sequence[Ends]], shunt_ohm: float | None = None, breaks_s: Sequence[float] = (),
+          rx_extra_S: complex = 0j) -> tuple[CArray, CArray, CArray, CArray]:
     """Receiver rail voltage (V) and cab current (A) of many configurations at once (batched ABCD products).
 
     Coordinates ``s`` are metres from the receiver end. ``ycap`` (C, F, N): admittance of each of the N capacitors
-    per carrier C and fault case F; ``z_km`` (C,): rail impedance per km; ``ballasts`` (B,) in ohm*km. Returns
-    ``v0`` (C, B, F) with no train and ``v``, ``i_cab`` (C, B, F, P) with one shunt at each of ``shunts_s``;
-    ``i_cab`` is the rail current on the transmitter side of the shunt. ``breaks_s``: broken rails (series
-    ``broken_rail_ohm``); ``rx_extra_S``: extra admittance at the receiver end (a failed insulation). The loops run
-    over the nodes of the line (capacitors, shunt points), never over configurations.
+    per carrier C and fault case F; ``z_km`` (C,): rail impedance per km; ``ballasts`` (B,) in ohm*km; ``ends``
+    (C, B): the section's ends per carrier and ballast (``ZpwParams.ends``). Returns ``v0`` (C, B, F) with no train,
+    ``v``, ``i_cab`` (C, B, F, P) with one shunt at each of ``shunts_s`` and ``vtx0`` (C, B, F), the rail voltage at
+    the transmitter end with no train; ``i_cab`` is the rail current on the transmitter side of the shunt.
+    ``breaks_s``: broken rails (series ``broken_rail_ohm``); ``rx_extra_S``: extra admittance at the receiver end (a
+    failed insulation). The loops run over the nodes of the line (capacitors, shunt points), never over
+    configurations.
     """
     r_sh = params.standard_shunt_ohm if shunt_ohm is None else shunt_ohm
     nodes = sorted([(s, 0, n) for n, s in enumerate(capacitors_s)] + [(s, 1, p) for p, s in enumerate(shunts_s)]
@@ -190,12 +196,17 @@ def solve(length_m: float, capacitors_s: Sequence[float], ycap: CArray, shunts_s
     sh = np.sinh(arg)[..., None]
     zsh, shz = zc[..., None] * sh, sh / zc[..., None]
     shape = (ycap.shape[0], len(ballasts), ycap.shape[1])
-    zs, ytx, yrx, zb = params.source_rail_ohm, params.tx_end_S, params.rx_end_S + rx_extra_S, params.broken_rail_ohm
+
+    def per_end(field: str) -> CArray:
+        return np.array([[complex(getattr(e, field)) for e in row] for row in ends])[..., None]  # (C, B, 1)
+
+    zs, ytx, emf = per_end("source_rail_ohm"), per_end("tx_end_S"), per_end("emf_V")
+    yrx, zb = per_end("rx_end_S") + rx_extra_S, params.broken_rail_ohm
     n_p = len(shunts_s)
     vs, is_, r0s, r1s = (np.empty((n_p, *shape), dtype=complex) for _ in range(4))
     # receiver -> transmitter: state [V, I] for 1 V at the receiver, I flowing towards the receiver
     v = np.ones(shape, dtype=complex)
-    i = np.full(shape, yrx, dtype=complex)
+    i = np.broadcast_to(yrx, shape).astype(complex)
     for k, (_, kind, idx) in enumerate(nodes):
         v, i = ch[k] * v + zsh[k] * i, shz[k] * v + ch[k] * i
         if kind == 0:
@@ -205,10 +216,11 @@ def solve(length_m: float, capacitors_s: Sequence[float], ycap: CArray, shunts_s
         else:
             v = v + zb * i
     v, i = ch[-1] * v + zsh[-1] * i, shz[-1] * v + ch[-1] * i
-    v0 = params.emf_V / ((1 + zs * ytx) * v + zs * i)
+    v0 = emf / ((1 + zs * ytx) * v + zs * i)
+    vtx0 = v0 * v
     # transmitter -> receiver: row vector r with EMF = r . [V, I] (for 1 V at the receiver)
-    r0 = np.full(shape, 1 + zs * ytx, dtype=complex)
-    r1 = np.full(shape, zs, dtype=complex)
+    r0 = np.broadcast_to(1 + zs * ytx, shape).astype(complex)
+    r1 = np.broadcast_to(zs, shape).astype(complex)
     r0, r1 = r0 * ch[-1] + r1 * shz[-1], r0 * zsh[-1] + r1 * ch[-1]
     for k in range(len(nodes) - 1, -1, -1):
         _, kind, idx = nodes[k]
@@ -220,8 +232,8 @@ def solve(length_m: float, capacitors_s: Sequence[float], ycap: CArray, shunts_s
             r1 = r1 + r0 * zb
         r0, r1 = r0 * ch[k] + r1 * shz[k], r0 * zsh[k] + r1 * ch[k]
     i_tx_side = is_ + vs / r_sh
-    vrx = params.emf_V / (r0s * vs + r1s * i_tx_side)
-    return v0, np.moveaxis(vrx, 0, -1), np.moveaxis(vrx * i_tx_side, 0, -1)
+    vrx = emf / (r0s * vs + r1s * i_tx_side)
+    return v0, np.moveaxis(vrx, 0, -1), np.moveaxis(vrx * i_tx_side, 0, -1), vtx0
 
 
 def _capacitor_table(carriers: Sequence[str], faults: Sequence[Mapping[int, str]], n: int, params: ZpwParams,
@@ -270,6 +282,7 @@ class SweepResult:
     adjustment_mV: FArray  # (C, B, F)
     residual_mV: FArray  # (C, B, F, P)
     cab_current_mA: FArray  # (C, B, F, P)
+    small_track_mV: FArray  # (C, B, F): the small track (transmitter-end tuning area) as its receiver reads it
 
     @property
     def max_shunt_residual_mV(self) -> FArray:
@@ -298,12 +311,18 @@ def sweep_section(length_m: float, capacitors_m: Sequence[float], carriers: Sequ
     z = np.array([params.rail_impedance(c) for c in carriers])
     ycap = _capacitor_table(carriers, cases, len(caps), params, capacitance_uF)
     healthy = _capacitor_table(carriers, [{}], len(caps), params, capacitance_uF)
-    reference, _, _ = solve(length_m, caps, healthy, (), z, (params.ballast_ohm_km,), params)
+    design = [[params.ends(c)] for c in carriers]
+    reference, _, _, vtx_ref = solve(length_m, caps, healthy, (), z, (params.ballast_ohm_km,), params, ends=design)
     gain = params.adjust_mV / np.abs(reference[:, 0, 0])  # mV per rail volt, per carrier
-    v0, v, i = solve(length_m, caps, ycap, pos, z, ballasts, params)
+    small = np.array([e[0].small_track for e in design])
+    reach = np.abs(vtx_ref[:, 0, 0] * small)  # 0 with insulated joints: no small track
+    small_gain = np.divide(params.adjust_mV, reach, out=np.zeros_like(reach), where=reach > 0)  # adjusted alike
+    v0, v, i, vtx = solve(length_m, caps, ycap, pos, z, ballasts, params,
+                          ends=[[params.ends(c, b) for b in ballasts] for c in carriers])
+    small_b = np.array([[params.ends(c, b).small_track for b in ballasts] for c in carriers])[..., None]
     return SweepResult(float(length_m), tuple(caps), tuple(carriers), tuple(float(b) for b in ballasts),
                        tuple(cases), pos, np.abs(v0) * gain[:, None, None], np.abs(v) * gain[:, None, None, None],
-                       np.abs(i) * 1000.0)
+                       np.abs(i) * 1000.0, np.abs(vtx * small_b) * small_gain[:, None, None])
 
 
 def sweep(lengths: Sequence[float], carriers: Sequence[str] = CARRIERS, ballasts: Sequence[float] = (1.0,),
@@ -360,6 +379,9 @@ class ZpwState:
         return self.voltage_mV >= self.drop_mV if previous_up else self.relay_up
 
 
+_Base = tuple[complex, complex, list[tuple[float, int, complex]], complex, Ends]
+
+
 class ZpwCircuit:
     """One ZPW-2000A section: ``evaluate(shunts, faults)`` with shunts ``(metres from the lower end, ohm)``.
 
@@ -386,10 +408,14 @@ class ZpwCircuit:
         self._z = params.rail_impedance(carrier)
         self._caps_s = sorted((self._s(x), n) for n, x in enumerate(self.capacitors_m, start=1))
         self._lines: dict[float, tuple[complex, complex]] = {}
-        self._bases: dict[tuple[object, ...], tuple[complex, complex, list[tuple[float, int, complex]], complex]] = {}
+        self._bases: dict[tuple[object, ...], _Base] = {}
         self._adjustments: dict[tuple[object, ...], ZpwState] = {}
         self.gain_mV_per_V = 1.0
-        self.gain_mV_per_V = params.adjust_mV / abs(self._rail((), NO_FAULTS)[0])
+        self.small_track_gain_mV_per_V = 1.0
+        vrx, _, vtx = self._rail((), NO_FAULTS)
+        self.gain_mV_per_V = params.adjust_mV / abs(vrx)
+        reach = abs(vtx * self._base(NO_FAULTS)[4].small_track)  # 0 with insulated joints: no small track
+        self.small_track_gain_mV_per_V = params.adjust_mV / reach if reach > 0 else 0.0
 
     def _s(self, x_m: float) -> float:
         """Position from the lower end -> distance from the receiver end."""
@@ -403,8 +429,11 @@ class ZpwCircuit:
             line = self._lines[ballast] = (cmath.sqrt(self._z * g), cmath.sqrt(self._z / g))
         return line
 
-    def _base(self, f: ZpwFaults) -> tuple[complex, complex, list[tuple[float, int, complex]], complex]:
-        """(gamma, zc, capacitor and break elements, receiver-end admittance) for a fault set, cached."""
+    def _ballast(self, f: ZpwFaults) -> float:
+        return self.params.ballast_ohm_km if f.ballast_ohm_km is None else f.ballast_ohm_km
+
+    def _base(self, f: ZpwFaults) -> _Base:
+        """(gamma, zc, capacitor and break elements, receiver-end admittance, ends) for a fault set, cached."""
         key = f.key()
         base = self._bases.get(key)
         if base is None:
@@ -418,17 +447,19 @@ class ZpwCircuit:
             if f.broken_rail_at_m is not None and 0.0 <= f.broken_rail_at_m <= self.length_m:
                 elements.append((self._s(f.broken_rail_at_m), 2, complex(p.broken_rail_ohm)))
             elements.sort(key=lambda e: (e[0], e[1]))
-            yrx = p.rx_end_S + (1.0 / p.insulation_short_ohm if f.insulation_short else 0.0)
-            gamma, zc = self._line(p.ballast_ohm_km if f.ballast_ohm_km is None else f.ballast_ohm_km)
-            base = self._bases[key] = (gamma, zc, elements, yrx)
+            ends = p.ends(self.carrier, self._ballast(f))
+            yrx = ends.rx_end_S + (1.0 / p.insulation_short_ohm if f.insulation_short else 0.0)
+            gamma, zc = self._line(self._ballast(f))
+            base = self._bases[key] = (gamma, zc, elements, yrx, ends)
             if len(self._bases) > 256:
                 self._bases.pop(next(iter(self._bases)))
         return base
 
-    def _rail(self, shunts: Sequence[tuple[float, float]], f: ZpwFaults) -> tuple[complex, complex | None]:
-        """Receiver rail voltage (V) and the rail current at the leading shunt (A), scalar chain."""
-        p = self.params
-        gamma, zc, elements, yrx = self._base(f)
+    def _rail(self, shunts: Sequence[tuple[float, float]], f: ZpwFaults, tx_end_S: complex | None = None,
+              ) -> tuple[complex, complex | None, complex]:
+        """Receiver rail voltage (V), the rail current at the leading shunt (A) and the rail voltage at the
+        transmitter end (V), scalar chain; ``tx_end_S`` replaces the transmitter end's tuning area."""
+        gamma, zc, elements, yrx, ends = self._base(f)
         if shunts:
             elements = sorted(elements + [(self._s(x), 1, complex(1.0 / max(r, 1e-9))) for x, r in shunts],
                               key=lambda e: (e[0], e[1]))
@@ -446,9 +477,9 @@ class ZpwCircuit:
                 i += value * v
             if k == last_shunt:
                 lead = i
-        zs = p.source_rail_ohm
-        vrx = p.emf_V / ((1 + zs * p.tx_end_S) * v + zs * i)
-        return vrx, (None if lead is None else vrx * lead)
+        zs = ends.source_rail_ohm
+        vrx = ends.emf_V / ((1 + zs * (ends.tx_end_S if tx_end_S is None else tx_end_S)) * v + zs * i)
+        return vrx, (None if lead is None else vrx * lead), vrx * v
 
     def evaluate(self, shunts: Sequence[tuple[float, float]] = (), faults: ZpwFaults | None = None) -> ZpwState:
         """Receiver state for wheelset shunts ``(metres from the section's lower end, ohm)``; outside ones ignored, a
@@ -458,7 +489,7 @@ class ZpwCircuit:
         inside = [(x, r) for x, r in shunts if -1e-9 <= x <= self.length_m + 1e-9]
         if not inside:
             return self.adjustment(f)
-        vrx, cab = self._rail(inside, f)
+        vrx, cab, _ = self._rail(inside, f)
         return ZpwState(abs(vrx) * self.gain_mV_per_V, None if cab is None else abs(cab) * 1000.0,
                         self.params.pickup_mV, self.params.drop_mV)
 
@@ -468,7 +499,7 @@ class ZpwCircuit:
         key = f.key()
         state = self._adjustments.get(key)
         if state is None:
-            vrx, _ = self._rail((), f)
+            vrx, _, _ = self._rail((), f)
             state = ZpwState(abs(vrx) * self.gain_mV_per_V, None, self.params.pickup_mV, self.params.drop_mV)
             self._adjustments[key] = state
             if len(self._adjustments) > 256:
@@ -484,11 +515,33 @@ class ZpwCircuit:
         elements = self._base(f)[2]  # validates the fault set
         pos = profile_points(self.length_m, p.profile_step_m) if positions_m is None else np.asarray(positions_m, float)
         ycap = np.array([e[2] for e in elements if e[1] == 0], dtype=complex).reshape(1, 1, -1)
-        _, v, i = solve(self.length_m, [s for s, _ in self._caps_s], ycap, [self._s(float(x)) for x in pos],
-                        np.array([self._z]), (p.ballast_ohm_km if f.ballast_ohm_km is None else f.ballast_ohm_km,),
-                        p, shunt_ohm=shunt_ohm, breaks_s=[e[0] for e in elements if e[1] == 2],
-                        rx_extra_S=1.0 / p.insulation_short_ohm if f.insulation_short else 0.0)
+        ballast = self._ballast(f)
+        _, v, i, _ = solve(self.length_m, [s for s, _ in self._caps_s], ycap, [self._s(float(x)) for x in pos],
+                           np.array([self._z]), (ballast,), p, ends=[[p.ends(self.carrier, ballast)]],
+                           shunt_ohm=shunt_ohm, breaks_s=[e[0] for e in elements if e[1] == 2],
+                           rx_extra_S=1.0 / p.insulation_short_ohm if f.insulation_short else 0.0)
         return pos, np.abs(v[0, 0, 0]) * self.gain_mV_per_V, np.abs(i[0, 0, 0]) * 1000.0
+
+    def small_track_mV(self, shunts: Sequence[tuple[float, float]] = (), faults: ZpwFaults | None = None, *,
+                       tuning_break_m: float | None = None, tuning_shunt_m: float | None = None,
+                       tuning_shunt_ohm: float | None = None) -> float:
+        """The small track (小轨道): the section's carrier across the rails at the far side of its transmitter-end
+        tuning area, as the neighbour's receiver reads it, in mV (adjusted like the main track: ``adjust_mV`` at the
+        design ballast with no train and no fault). ``shunts`` and ``faults`` are the main track's; a broken rail
+        (``tuning_break_m``) or a wheelset (``tuning_shunt_m``, ``tuning_shunt_ohm``) in the tuning area are given in
+        metres from the section's end. It falls with a train in the tuning area or near the transmitter and with a
+        broken rail in the tuning area: the small track's check."""
+        f = faults or NO_FAULTS
+        check_shunts(shunts)
+        ends = self._base(f)[4]
+        y_tx, small = ends.tx_end_S, ends.small_track
+        if tuning_break_m is not None or tuning_shunt_m is not None:
+            y_tx, small = zpwends.small_track_transfer(
+                self.params, self.carrier, self.frequency_Hz, self._ballast(f), break_at_m=tuning_break_m,
+                shunt_at_m=tuning_shunt_m, shunt_ohm=tuning_shunt_ohm)
+        inside = [(x, r) for x, r in shunts if -1e-9 <= x <= self.length_m + 1e-9]
+        _, _, vtx = self._rail(inside, f, y_tx)
+        return abs(vtx * small) * self.small_track_gain_mV_per_V
 
     def max_shunt_residual_mV(self, faults: ZpwFaults | None = None) -> float:
         return float(self.profile(faults)[1].max())

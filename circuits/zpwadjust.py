@@ -234,6 +234,13 @@ class Verdict:
     pickup_mV: float
     drop_mV: float
     ballast_min_ohm_km: float
+    min_cab_mA: float = math.inf  # healthy, standard shunt anywhere, design minimum ballast, the row's level
+    cab_min_mA: float = 0.0  # the carrier's cab-signal minimum
+
+    @property
+    def feeds_cab(self) -> bool:
+        """The row's level gives the cab-signal minimum everywhere on the healthy section."""
+        return self.min_cab_mA >= self.cab_min_mA
 
     @property
     def detects(self) -> bool:
@@ -256,8 +263,9 @@ def check_circuit(circuit: ZpwCircuit, section: str = "") -> Verdict:
                                            circuit.capacitors_m, circuit.capacitance_uF)
     adjust = circuit.adjustment(ZpwFaults(ballast_ohm_km=t.ballast_min_ohm_km)).voltage_mV
     row = t.row(circuit.carrier, circuit.length_m)
+    cab = circuit.min_cab_current_mA(ZpwFaults(ballast_ohm_km=t.ballast_min_ohm_km))
     return Verdict(section, circuit.carrier, circuit.length_m, row.level, adjust, per_mV * adjust, ballast, fault,
-                   p.pickup_mV, p.drop_mV, t.ballast_min_ohm_km)
+                   p.pickup_mV, p.drop_mV, t.ballast_min_ohm_km, cab, circuit.cab_min_mA)
 
 
 def station_verdicts(station: Station) -> list[Verdict]:
@@ -275,7 +283,17 @@ def station_warnings(station: Station) -> list[Diagnostic]:
     from liansuo.stations.source import Diagnostic
 
     out = []
+    src = station.source
     for v in station_verdicts(station):
+        loc = ("sections", next(i for i, s in enumerate(station.model.sections) if s.id == v.section))
+        if not v.feeds_cab:
+            message = (f"ZPW-2000A section '{v.section}' ({v.carrier}, {v.length_m:g} m) is longer than its "
+                       f"transmitter feeds: at level {v.level} a 0.15 ohm shunt reads {v.min_cab_mA:.0f} mA "
+                       f"(cab-signal minimum {v.cab_min_mA:g} mA) at {v.ballast_min_ohm_km:g} ohm*km: the cab may "
+                       "lose the code")
+            hint = "shorten the section (split it with an electrical joint)"
+            out.append(Diagnostic("<station>", 1, 1, message, hint, "warning") if src is None
+                       else src.diagnostic(loc, message, hint, severity="warning"))
         if v.ok:
             continue
         message = (f"ZPW-2000A section '{v.section}' ({v.carrier}, {v.length_m:g} m) cannot be adjusted over the "
@@ -287,8 +305,6 @@ def station_warnings(station: Station) -> list[Diagnostic]:
         if not v.picks_up:
             message += "; the relay does not pick up at the design minimum ballast"
         hint = "shorten the section (split it with an electrical joint) or check its capacitors"
-        loc = ("sections", next(i for i, s in enumerate(station.model.sections) if s.id == v.section))
-        src = station.source
         out.append(Diagnostic("<station>", 1, 1, message, hint, "warning") if src is None
                    else src.diagnostic(loc, message, hint, severity="warning"))
     return out

@@ -29,7 +29,6 @@ QUANTITIES = ("adjustment_voltage", "min_cab_current", "max_shunt_residual", "sm
 QUANTITY_TEXT = {"adjustment_voltage": "adjustment", "min_cab_current": "min cab current",
                  "max_shunt_residual": "max residual", "small_track_voltage": "small track"}
 FAULT_TEXT = {"open": "open", "half": "-50 %"}
-INSULATED_END_OHM = 1.0e9  # no tuning unit across the rails at an insulated joint
 
 
 @dataclass(frozen=True)
@@ -107,7 +106,7 @@ def _changes(section: Section, carriers: Sequence[str], ballast: float) -> dict[
 
     params = DEFAULT_PARAMS
     if section.ends == "insulated":
-        params = dataclasses.replace(params, tuning_ohm=complex(INSULATED_END_OHM, 0.0))
+        params = dataclasses.replace(params, tuning_units=False)
     caps = standard_positions(section.length_m, None, params)
     n = len(caps)
     modes = ("open", "half")
@@ -116,6 +115,8 @@ def _changes(section: Section, carriers: Sequence[str], ballast: float) -> dict[
     figures = {"adjustment_voltage": result.adjustment_mV[:, 0, :],
                "min_cab_current": result.min_cab_current_mA[:, 0, :],
                "max_shunt_residual": result.max_shunt_residual_mV[:, 0, :]}
+    if section.ends == "tuned":  # the small track is the tuning area at the transmitter end
+        figures["small_track_voltage"] = result.small_track_mV[:, 0, :]
     out: dict[str, dict[str, list[float]]] = {}
     for m, mode in enumerate(modes):
         chosen = slice(1 + m * n, 1 + (m + 1) * n)

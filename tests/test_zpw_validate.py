@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 
 from liansuo.circuits.zpw2000a import ZpwCircuit, ZpwFaults, standard_positions
-from liansuo.circuits.zpwvalidate import QUANTITIES, read_article, trend_ok
+from liansuo.circuits.zpwvalidate import QUANTITIES, TARGET_SHARE, read_article, trend_ok
 from liansuo.cli.main import main
 from liansuo.stations.fit import columns
 from liansuo.stations.jsonreport import SCHEMAS, version
@@ -49,12 +49,26 @@ def test_json_shape_and_summary(capsys: pytest.CaptureFixture[str]) -> None:
         for key in KEYS[4:8]:
             assert row[key] is None or (isinstance(row[key], float) and row[key] >= 0.0)
         assert row["trend_ok"] is trend_ok(*(row[k] for k in KEYS[4:8]))
-        if row["quantity"] == "small_track_voltage":  # the model has no small track yet
-            assert row["model_rise_pct"] is None and row["trend_ok"] is False
-        else:
-            assert row["model_rise_pct"] is not None and row["model_fall_pct"] is not None
+        assert row["model_rise_pct"] is not None and row["model_fall_pct"] is not None  # all four modelled
     agree = sum(1 for r in rows if r["trend_ok"])
     assert data["summary"] == {"rows": 28, "trend_ok": agree, "share": round(agree / 28, 3)}
+
+
+def test_the_system_model_reaches_the_target(capsys: pytest.CaptureFixture[str]) -> None:
+    """Issue 15: the trend agrees on at least 80 % of the rows. The rows that still differ are the four material
+    rises of the minimum cab current on the 1400 m open line (docs/zpw2000a.md says why); every small-track and
+    residual row agrees, and the station section without frequency selection has its cab-current rise."""
+    rows = json_report(capsys)["rows"]
+    assert isinstance(rows, list)
+    assert sum(r["trend_ok"] for r in rows) / len(rows) >= TARGET_SHARE
+    differ = {(r["table"], r["section"], r["quantity"]) for r in rows if not r["trend_ok"]}
+    assert differ == {(t, s, "min_cab_current") for t in (1, 2) for s in ("passenger-line", "conventional-line")}
+    by = {(r["table"], r["section"], r["quantity"]): r for r in rows}
+    for t in (1, 2):
+        small = by[t, "conventional-line", "small_track_voltage"]
+        assert small["model_rise_pct"] > 5.0 and small["model_fall_pct"] > 5.0  # both ways, by tens of percent
+        assert by[t, "station-no-selection", "min_cab_current"]["model_rise_pct"] > 5.0
+        assert by[t, "passenger-line", "min_cab_current"]["model_rise_pct"] <= 5.0  # the rise it lacks
 
 
 def test_the_articles_rows_are_transcribed(capsys: pytest.CaptureFixture[str]) -> None:
@@ -91,7 +105,7 @@ def test_the_articles_rows_are_transcribed(capsys: pytest.CaptureFixture[str]) -
     ((31.1, 21.5), (9.0, 4.9), False),  # a material fall the model does not have
     ((0.6, 38.4), (0.0, 40.6), True),  # a small change in the article: any model figure agrees
     ((0.6, 38.4), (30.0, 40.6), True),
-    ((28.9, 21.5), (None, None), False),  # not modelled
+    ((28.9, 21.5), (None, None), False),  # not computed
 ])
 def test_trend_rule(paper: tuple[float | None, float | None], model: tuple[float | None, float | None],
                     ok: bool) -> None:
