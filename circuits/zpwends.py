@@ -22,19 +22,59 @@ equipment room, ``cable_km`` of cable away (an exact uniform-line two-port with 
 a matching transformer of ``matching_ratio`` : 1 at the track. The small track (小轨道) of a section is the tuning area
 at its transmitter end: the neighbour's receiver reads the section's carrier across the rails at the far side of it.
 
-Only numpy and the standard library: the parameters are a :class:`~liansuo.circuits.zpw2000a.ZpwParams`.
+Only the standard library: the parameters are a :class:`~liansuo.circuits.zpw2000a.ZpwParams`.
 """
 
 from __future__ import annotations
 
 import cmath
 import math
+from collections.abc import Hashable
 from dataclasses import dataclass
 from functools import lru_cache
-from typing import TYPE_CHECKING
+from typing import Protocol
 
-if TYPE_CHECKING:
-    from .zpw2000a import ZpwParams
+
+class ZpwParams(Hashable, Protocol):
+    """The parameters the ends are built from: those of :class:`~liansuo.circuits.zpw2000a.ZpwParams` (named here,
+    not imported, so that the section's model may build on this module)."""
+
+    @property
+    def rail_resistance_ohm_km(self) -> tuple[float, float, float, float]: ...
+    @property
+    def rail_inductance_mH_km(self) -> tuple[float, float, float, float]: ...
+    @property
+    def ballast_ohm_km(self) -> float: ...
+    @property
+    def broken_rail_ohm(self) -> float: ...
+    @property
+    def standard_shunt_ohm(self) -> float: ...
+    @property
+    def transmitter_V(self) -> float: ...
+    @property
+    def matching_ratio(self) -> float: ...
+    @property
+    def source_ohm(self) -> complex: ...
+    @property
+    def receiver_ohm(self) -> complex: ...
+    @property
+    def cable_km(self) -> float: ...
+    @property
+    def cable_ohm_km(self) -> float: ...
+    @property
+    def cable_mH_km(self) -> float: ...
+    @property
+    def cable_nF_km(self) -> float: ...
+    @property
+    def tuning_units(self) -> bool: ...
+    @property
+    def tuning_area_m(self) -> float: ...
+    @property
+    def air_core_uH(self) -> float: ...
+    @property
+    def tuning_q(self) -> float: ...
+    @property
+    def f2_inductance_uH(self) -> float: ...
 
 PARTNER = {"1700": "2300", "2300": "1700", "2000": "2600", "2600": "2000"}  # TB/T 3206 frequency plan
 Chain = tuple[complex, complex, complex, complex]  # (A, B, C, D): [V, I] near = [[A, B], [C, D]] [V, I] far
