@@ -38,7 +38,10 @@ def seat_row(s: dict[str, Any]) -> tuple[str, ...]:
     if progress:
         left = progress.get("time_left_s")
         met = f"{progress.get('goals_met', 0)}/{progress.get('goals', 0)} goals"
-        shown = met + (f", {clock_text(float(left))} left" if left is not None else "")
+        if progress.get("finished"):
+            shown = f"{met}, ended: {progress.get('ended', '')}"
+        else:
+            shown = met + (f", {clock_text(float(left))} left" if left is not None else "")
     else:
         shown = ""
     score = s.get("score")

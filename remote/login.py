@@ -80,6 +80,13 @@ class LoginScreen(ModalScreen[Link | None]):
         pressed = self.query_one(RadioSet).pressed_button
         return "instructor" if pressed is not None and pressed.id == "instructor" else "trainee"
 
+    def on_input_changed(self, event: Input.Changed) -> None:
+        """Typing a password chooses the instructor, typing a name or a seat the trainee."""
+        if event.value and event.input.id in ("name", "seat", "password"):
+            chosen = "instructor" if event.input.id == "password" else "trainee"
+            if self.role() != chosen:
+                self.query_one(f"#{chosen}", RadioButton).value = True
+
     def on_input_submitted(self, event: Input.Submitted) -> None:
         self.connect()
 

@@ -300,3 +300,18 @@ async def test_a_trainee_reads_the_exercise_started_on_the_seat_and_its_score_at
         await until(pilot, lambda: "goals met" in str(app.status_bar.content), 12)
         assert "score" in log(app) and "2/2 goals" in str(app.status_bar.content)
     assert [p.suffix for p in server.classroom.seat(1).desk.reported] == [".json", ".txt", ".html"]
+
+
+def test_the_dashboard_row_says_how_far_an_exercise_is_and_how_it_ended() -> None:
+    from liansuo.remote.dashboard import COLUMNS, seat_row
+
+    base = {"seat": 1, "trainee": "Li", "connected": True, "station": "jiaopei", "t": 75.0, "paused": False,
+            "speed": 1.0, "alarms": 0, "refused": 1, "exercise": "jiaopei-cancel-route"}
+    going = dict(zip(COLUMNS, seat_row({**base, "score": 40.0, "progress": {
+        "goals_met": 1, "goals": 2, "time_left_s": 252.0, "finished": False, "ended": ""}}), strict=True))
+    assert going["progress"] == "1/2 goals, 00:04:12.0 left" and going["score"] == "40.0"
+    done = dict(zip(COLUMNS, seat_row({**base, "score": 98.0, "progress": {
+        "goals_met": 2, "goals": 2, "time_left_s": 200.0, "finished": True, "ended": "goals met"}}), strict=True))
+    assert done["progress"] == "2/2 goals, ended: goals met" and "left" not in done["progress"]
+    idle = dict(zip(COLUMNS, seat_row({**base, "exercise": None, "progress": None, "score": None}), strict=True))
+    assert idle["exercise"] == idle["progress"] == idle["score"] == ""

@@ -78,6 +78,10 @@ def test_the_status_and_answer_lines_say_why_the_signal_just_set_stays_red() -> 
             cycles(app, 4)
             assert "XI red: block line SL has not been accepted" in str(app.status_bar.content)
             assert "XI red: block line SL" in str(app.message_line.content)
+            assert app.sim.command("cancel XI").ok  # not through the console: as a classroom's seat changes
+            cycles(app, 4)
+            assert "XI red" not in str(app.status_bar.content)
+            assert str(app.message_line.content) == ""  # the reason it said is out of date, so it is gone
 
     asyncio.run(body())
 

@@ -293,6 +293,8 @@ class ConsoleApp(SafeApp):
         self.function_bar.set_counts(sim.sealed_uses())
         waiting = waiting_text(sim, self.diagram.cursor)
         if waiting != self._waiting:  # a signal newly waiting: say why on the answer line too
+            if not waiting and self.message_line.said == self._waiting:
+                self.say("")  # it waits no more: the reason said is out of date
             self._waiting = waiting
             if waiting:
                 self.say(waiting)

@@ -238,7 +238,10 @@ class MessageLine(Guarded, Static):
     MessageLine { height: 1; background: #15181c; }
     """
 
+    said = ""  # the text said last, as given
+
     def say(self, text: str, ok: bool | None = None) -> None:
+        self.said = text
         style = "#e0e0e0" if ok is None else "bold #40e070" if ok else "bold #ff5050"
         mark = "" if ok is None else "✓ " if ok else "✗ "
         self.update(Text(mark + printable(text), style=style, no_wrap=True, overflow="ellipsis"))
