@@ -212,7 +212,12 @@ def test_the_figures_in_the_docs_are_made_by_their_commands() -> None:
     images = sorted((ROOT / "docs" / "images").glob("*.png"))
     assert images
     docs = "".join(p.read_text(encoding="utf-8") for p in (ROOT / "docs").glob("*.md"))
+    shots = ROOT / "tests" / "classroom_screenshots.py"  # the classroom's pictures, taken in a headless browser
     for image in images:
         assert f"images/{image.name})" in docs, f"{image.name} is not shown"
-        assert f"--plot docs/images/{image.name}" in docs, f"no command for {image.name}"
+        if image.name.startswith("classroom-"):
+            assert image.name in shots.read_text(encoding="utf-8"), f"{image.name} is not taken by {shots.name}"
+            assert f"python tests/{shots.name} docs/images" in docs, f"no command for {image.name}"
+        else:
+            assert f"--plot docs/images/{image.name}" in docs, f"no command for {image.name}"
         assert image.read_bytes()[:8] == PNG_SIGNATURE
