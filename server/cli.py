@@ -63,6 +63,13 @@ def cmd_serve(args: argparse.Namespace) -> int:
     for name, port in (("--port", args.port), ("--web-port", args.web_port)):
         if not 0 <= port <= 65535:
             return refuse("serve", f"{name} is 0 to 65535, not {port}", Exit.USAGE)
+    if args.web and args.public_url is None and args.host in ("0.0.0.0", "::", ""):
+        return refuse("serve", f"with --host {args.host} and --web, give --public-url http://ADDRESS:{args.web_port} "
+                      "(this machine's address as the classroom's browsers reach it): the page tells them where to "
+                      "connect", Exit.USAGE)
+    if args.public_url is not None and not args.public_url.startswith(("http://", "https://")):
+        return refuse("serve", f"--public-url is an http:// or https:// address, not {args.public_url!r}",
+                      Exit.USAGE)
     try:
         stored = instructor_hash(args.password_file)
     except PasswordError as exc:

@@ -161,3 +161,16 @@ def test_a_team_shares_one_station_and_its_clock() -> None:
         assert not alone.seat(2).sim.view.routes()
     finally:
         alone.close()
+
+
+def test_serving_browsers_on_every_address_needs_the_address_they_reach(capsys: pytest.CaptureFixture[str],
+                                                                       tmp_path: Path) -> None:
+    from liansuo.cli.main import main
+
+    secret = tmp_path / "pw"
+    secret.write_text(hash_password(PASSWORD) + "\n", encoding="utf-8")
+    assert main(["serve", "--web", "--host", "0.0.0.0", "--password-file", str(secret)]) == 2
+    err = capsys.readouterr().err
+    assert "give --public-url http://ADDRESS:8000" in err and err.count("\n") == 1
+    assert main(["serve", "--web", "--public-url", "10.0.0.5:8000", "--password-file", str(secret)]) == 2
+    assert "an http:// or https:// address" in capsys.readouterr().err
