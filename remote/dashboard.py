@@ -45,9 +45,10 @@ def seat_row(s: dict[str, Any]) -> tuple[str, ...]:
     else:
         shown = ""
     score = s.get("score")
+    clock = "stopped: error" if s.get("broken") else "paused" if s.get("paused") else f"{float(s.get('speed', 1.0)):g}x"
     return (str(s.get("seat", "")), printable(str(s.get("trainee") or "")), "yes" if s.get("connected") else "no",
             printable(str(s.get("station", ""))), clock_text(float(s.get("t", 0.0))),
-            "paused" if s.get("paused") else f"{float(s.get('speed', 1.0)):g}x",
+            clock,
             printable(str(s.get("exercise") or "")), shown, "" if score is None else f"{score}",
             str(s.get("alarms", 0)), str(s.get("refused", 0)))
 

@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import re
 import secrets
+import sys
+import traceback
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -36,6 +38,7 @@ class Desk:
     debt: float = 0.0
     assessment: Assessment | None = None  # the exercise being worked at this desk, scored
     reported: list[Path] = field(default_factory=list)  # the reports written when it ended
+    broken: str = ""  # why the desk's clock was stopped by an internal error ('' while it is sound)
 
 
 @dataclass
@@ -63,7 +66,7 @@ class Seat:
                 "exercise": None if a is None else a.exercise.name,
                 "progress": None if a is None else a.progress(),
                 "score": None if a is None else a.progress()["score"],
-                "reports": [str(p) for p in d.reported]}
+                "reports": [str(p) for p in d.reported], "broken": d.broken}
 
     def briefing(self) -> dict[str, Any] | None:
         """What the trainee at this seat is told of the exercise, and how it stands (no fault is named)."""
@@ -171,6 +174,9 @@ class Classroom:
     def set_clock(self, seats: list[int], *, paused: bool | None = None, speed: float | None = None) -> None:
         if speed is not None and not 0.1 <= speed <= 64:
             raise SeatError(f"a speed is 0.1 to 64 times real time, not {speed:g}")
+        broken = [n for n in seats if self.seat(n).desk.broken and paused is False]
+        if broken:
+            raise SeatError(f"seat {broken[0]} was {self.seat(broken[0]).desk.broken}: reset it to run it again")
         for d in self.desks(seats):
             if paused is not None:
                 d.paused = paused
@@ -184,7 +190,7 @@ class Classroom:
 
     def _fresh(self, d: Desk, sim: Simulation) -> None:
         d.sim.close()
-        d.sim, d.debt, d.assessment, d.reported = sim, 0.0, None, []
+        d.sim, d.debt, d.assessment, d.reported, d.broken = sim, 0.0, None, [], ""
         for s in self.seats.values():
             if s.desk is d:
                 s.refused, s.log = 0, []
@@ -261,18 +267,26 @@ class Classroom:
         return out
 
     def advance(self, wall_s: float) -> None:
-        """Run every desk's clock on by ``wall_s`` seconds of the wall clock, at its speed."""
+        """Run every desk's clock on by ``wall_s`` seconds of the wall clock, at its speed. A desk whose simulation
+        fails is stopped (paused, with the reason in its summary; the traceback on stderr), never the others."""
         for d in self.desks():
             if d.paused:
                 continue
-            d.debt += wall_s * d.speed
-            n = min(int(d.debt / d.sim.cycle_s), MAX_STEPS)
-            d.debt = min(d.debt - n * d.sim.cycle_s, d.sim.cycle_s)
-            for _ in range(n):
-                d.sim.step()
-            if d.assessment is not None and not d.assessment.finished:
-                d.assessment.tick()
-                self._report_if_ended(d)
+            try:
+                self._run(d, wall_s)
+            except Exception:  # the other seats' classes go on
+                d.paused, d.broken = True, "stopped by an internal error of its simulation (in the server's log)"
+                traceback.print_exc(file=sys.stderr)
+
+    def _run(self, d: Desk, wall_s: float) -> None:
+        d.debt += wall_s * d.speed
+        n = min(int(d.debt / d.sim.cycle_s), MAX_STEPS)
+        d.debt = min(d.debt - n * d.sim.cycle_s, d.sim.cycle_s)
+        for _ in range(n):
+            d.sim.step()
+        if d.assessment is not None and not d.assessment.finished:
+            d.assessment.tick()
+            self._report_if_ended(d)
 
     def close(self) -> None:
         for d in self.desks():

@@ -133,3 +133,24 @@ def test_the_instructor_starts_and_stops_exercises_over_the_protocol(room: Class
     stopped = server.answer(teacher, json.dumps({"type": "stop", "seats": [1, 3]}))
     assert stopped["type"] == "ok" and len(stopped["reports"]) == 6
     assert {Path(p).name.split("-")[0] for p in stopped["reports"]} == {"seat1", "seat3"}
+
+
+def test_a_seat_whose_simulation_fails_stops_alone_and_says_why(room: Classroom, monkeypatch: pytest.MonkeyPatch,
+                                                                capsys: pytest.CaptureFixture[str]) -> None:
+    def fails() -> None:
+        raise RuntimeError("a defect of the simulation")
+
+    monkeypatch.setattr(room.seat(2).sim, "step", fails)
+    t1 = room.seat(1).sim.t
+    run_for(room, 2)
+    assert room.seat(1).sim.t > t1 and room.seat(3).sim.t > t1  # the other seats' clocks go on
+    summary = room.seat(2).summary()
+    assert summary["paused"] and "internal error" in summary["broken"]
+    assert "a defect of the simulation" in capsys.readouterr().err  # the traceback, in the server's log
+    with pytest.raises(SeatError, match=r"seat 2 was stopped by an internal error.*reset it"):
+        room.set_clock([2], paused=False)
+    room.reset([2])  # a fresh simulation mends it
+    assert room.seat(2).summary()["broken"] == ""
+    room.set_clock([2], paused=False)
+    run_for(room, 1)
+    assert room.seat(2).sim.t > 0
