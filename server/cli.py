@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import asyncio
 import getpass
+import signal
 import socket
 import sys
 from collections.abc import Callable
@@ -100,7 +101,7 @@ def cmd_serve(args: argparse.Namespace) -> int:
         asyncio.run(_serve(server, args.host, args.port, web_port, args.public_url))
     except OSError as exc:
         return refuse("serve", f"cannot listen on {args.host}:{args.port}: {exc.strerror or exc}", Exit.USAGE)
-    except KeyboardInterrupt:
+    except (KeyboardInterrupt, asyncio.CancelledError):
         pass
     finally:
         classroom.close()
@@ -118,6 +119,7 @@ def _free(host: str, port: int) -> int:
 async def _serve(server: ClassroomServer, host: str, port: int, web_port: int | None, public_url: str | None) -> None:
     ready: asyncio.Future[int] = asyncio.get_running_loop().create_future()
     task = asyncio.create_task(server.serve(host, port, ready))
+    asyncio.get_running_loop().add_signal_handler(signal.SIGTERM, task.cancel)  # kill: stop as ctrl+c does
     while not ready.done():  # listening, or the task ended: the OSError of a port it could not listen on goes up
         if task.done():
             task.result()

@@ -174,3 +174,32 @@ def test_serving_browsers_on_every_address_needs_the_address_they_reach(capsys: 
     assert "give --public-url http://ADDRESS:8000" in err and err.count("\n") == 1
     assert main(["serve", "--web", "--public-url", "10.0.0.5:8000", "--password-file", str(secret)]) == 2
     assert "an http:// or https:// address" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("how", ["terminate", "kill"])
+def test_the_browsers_page_ends_with_the_server_however_it_ends(how: str, tmp_path: Path) -> None:
+    import socket
+
+    secret = tmp_path / "pw"
+    secret.write_text(hash_password(PASSWORD) + "\n", encoding="utf-8")
+    proc = subprocess.Popen([sys.executable, "-m", "liansuo.cli", "serve", "--port", "0", "--web", "--web-port", "0",
+                             "--password-file", str(secret)], stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
+                            text=True)
+    assert proc.stdout is not None
+    first = proc.stdout.readline()
+    port = int(first.split("browsers on ")[1].split()[0].rsplit(":", 1)[1])
+
+    def listening() -> bool:
+        with socket.socket() as s:
+            return s.connect_ex(("127.0.0.1", port)) == 0
+
+    deadline = time.monotonic() + 20
+    while not listening():
+        assert time.monotonic() < deadline, "the browsers' page never came up"
+        time.sleep(0.2)
+    getattr(proc, how)()  # SIGTERM: the server stops it; SIGKILL: it notices its server is gone
+    proc.wait(10)
+    deadline = time.monotonic() + 10
+    while listening():
+        assert time.monotonic() < deadline, f"the browsers' page outlived its server ({how})"
+        time.sleep(0.2)
