@@ -241,10 +241,12 @@ class Classroom:
         return f"exercise '{ex.title}' started on seats {', '.join(map(str, started))}"
 
     def stop_exercise(self, seats: list[int]) -> list[Path]:
-        """End the exercise on these seats' desks now, and write its reports (those already written stay)."""
+        """End the exercise on these seats' desks now (the trainee is told), and write its reports (those already
+        written stay)."""
         out: list[Path] = []
         for d in self.desks(seats):
             if d.assessment is not None:
+                d.assessment.stop()
                 if not d.reported:
                     d.reported = self._write(d)
                 out += d.reported

@@ -169,6 +169,11 @@ class Assessment:
                 and all(t is not None for t in self.diagnosed_at)):
             self._end("goals met", self.sim.t)
 
+    def stop(self, why: str = "stopped by the instructor") -> None:
+        """End the attempt now (nothing more is recorded or scored); its report says ``why``."""
+        if not self.finished:
+            self._end(why, self.sim.t)
+
     def _end(self, why: str, at: float) -> None:
         self.ended = why
         self.finished_at = at

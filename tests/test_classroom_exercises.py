@@ -78,7 +78,12 @@ def test_stop_writes_the_report_of_an_unfinished_exercise_and_a_second_attempt_k
     first = room.stop_exercise([2])
     assert first[0].name == "seat2-Wang-jiaopei-cancel-route.json"
     report = json.loads(first[0].read_text(encoding="utf-8"))
-    assert report["ended"] == "stopped before the end" and not report["all_goals_met"]
+    assert report["ended"] == "stopped by the instructor" and not report["all_goals_met"]
+    told = room.snapshot(2, "trainee", EventCursor())["exercise"]
+    assert told["finished"] and told["ended"] == "stopped by the instructor" and told["score"] is not None
+    room.command(2, "trainee", "cancel X")
+    stopped = room.seat(2).desk.assessment
+    assert stopped is not None and stopped.entries == []  # after the stop nothing more is recorded
     assert room.stop_exercise([2]) == first  # stopping again writes nothing new
     room.start_exercise([2], "jiaopei-cancel-route")
     assert room.stop_exercise([2])[0].name == "seat2-Wang-jiaopei-cancel-route-2.json"
