@@ -142,15 +142,17 @@ def log_in(browser: Browser, web: str, teacher: ClassroomClient, name: str, seat
     """Open the page and log in as a trainee; again, on a fresh page, if a loaded machine lost the keys."""
     for attempt in range(3):
         browser.open(web)
-        until(lambda: bool(browser.evaluate(f"!!document.querySelector('{TEXTAREA}')")), what="the page's terminal")
-        time.sleep(4.0 + 3.0 * attempt)  # the client process starts, asks the lobby and draws the login screen
+        # the page marks its body once the client process draws (it has asked the server's lobby by then)
+        until(lambda: bool(browser.evaluate("document.body.classList.contains('-first-byte')")), 60,
+              "the console drawing on the page")
+        time.sleep(2.0 + 2.0 * attempt)  # the login screen over it
         browser.focus(TEXTAREA)
         browser.type(name)
         browser.press("Tab")
         browser.type(str(seat))
         browser.press("Enter")
         try:
-            until(lambda: seat_of(teacher, seat)["connected"] and seat_of(teacher, seat)["trainee"] == name, 15,
+            until(lambda: seat_of(teacher, seat)["connected"] and seat_of(teacher, seat)["trainee"] == name, 20,
                   f"{name} at seat {seat} from the browser")
             return
         except AssertionError:
