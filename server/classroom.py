@@ -58,14 +58,13 @@ class Seat:
     def summary(self) -> dict[str, Any]:
         """What the instructor's dashboard shows of this seat."""
         d = self.desk
-        a = d.assessment
+        progress = None if d.assessment is None else d.assessment.progress()
         return {"seat": self.number, "station": d.sim.station.id, "trainee": self.trainee,
                 "connected": self.connected, "t": d.sim.t, "paused": d.paused, "speed": d.speed,
                 "alarms": len(d.sim.alarm_views()), "refused": self.refused,
                 "commands": sum(w != INSTRUCTOR for _, w, *_ in self.log),
-                "exercise": None if a is None else a.exercise.name,
-                "progress": None if a is None else a.progress(),
-                "score": None if a is None else a.progress()["score"],
+                "exercise": None if d.assessment is None else d.assessment.exercise.name,
+                "progress": progress, "score": None if progress is None else progress["score"],
                 "reports": [str(p) for p in d.reported], "broken": d.broken}
 
     def briefing(self) -> dict[str, Any] | None:
