@@ -8,11 +8,11 @@ block machines, and the console's answer to "is this turnout locked".
 
 from __future__ import annotations
 
-import shlex
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from liansuo.rules import RuleSet
+from liansuo.simulation.language import split_words
 
 from .check import Finding, Oracle
 
@@ -161,7 +161,7 @@ class Watch:
 
     def note(self, line: str, result: Result) -> None:
         try:
-            words = shlex.split(line.split("#", 1)[0])
+            words = split_words(line.split("#", 1)[0])
         except ValueError:
             return
         self.oracle.note(words, result.ok)
