@@ -36,6 +36,9 @@ class Mutant:
     name: str
     what: str  # the defect, in words
     apply: Apply
+    # where the defect shows (a bundled name, an example station's file name or hub:T:N): tried there first, so a
+    # run stops early; the other stations are still tried after it when it is not caught there
+    first: str = ""
 
     @contextmanager
     def applied(self) -> Iterator[None]:
@@ -313,18 +316,18 @@ MUTANTS: tuple[Mutant, ...] = (
     Mutant("no-head-on-enemies", "the table leaves out opposing routes onto one track (train against train or "
            "shunting movement)", _no_head_on),
     Mutant("no-diamond", "the table ignores diamond crossings: no conflict, no protection of the crossing track",
-           _no_diamonds),
-    Mutant("no-flank-protection", "the table lists no flank protection turnouts", _no_protection),
+           _no_diamonds, first="shuangxian"),
+    Mutant("no-flank-protection", "the table lists no flank protection turnouts", _no_protection, first="doubleslip"),
     Mutant("guide-over-lost-indication", "the guide aspect opens over a route with a turnout out of position or "
            "without indication", _guide_over_lost_indication),
     Mutant("no-run-on", "a shunting route ending at a signal of the other direction stops there on paper; the "
            "movement runs on unprotected", _no_run_on),
-    Mutant("no-overlap", "receiving routes lock no overlap (延续进路)", _no_overlap),
+    Mutant("no-overlap", "receiving routes lock no overlap (延续进路)", _no_overlap, first="danxian"),
     Mutant("approach-one-section", "approach locking is one section everywhere, whatever the line",
-           _approach_one_section),
+           _approach_one_section, first="shuangxian"),
     Mutant("empty-conflict-table", "the table lists no conflicting routes at all", _no_conflict_table),
     Mutant("usu-without-onward-check", "USU is given whatever turnouts the onward route diverges over",
-           _usu_without_onward),
+           _usu_without_onward, first="shuangxian"),
     Mutant("throw-ignores-locks", "individual operation moves a locked turnout", _throw_ignores_locks),
     Mutant("throw-ignores-section-locks", "a turnout standing in a locked section is not locked with it",
            _throw_ignores_section_locks),
@@ -340,29 +343,30 @@ MUTANTS: tuple[Mutant, ...] = (
     Mutant("no-red-lamp-check", "a dark red lamp goes unnoticed: no red lamp transfer (红灯转移)",
            _no_red_lamp_check),
     Mutant("no-red-lamp-transfer-on-the-line", "the block signal in rear of a dark red lamp is not held at H",
-           _no_red_lamp_transfer_on_the_line),
+           _no_red_lamp_transfer_on_the_line, first="shuangxian"),
     Mutant("no-lamp-proving", "a dark lamp does not change the aspect commanded", _no_lamp_proving),
-    Mutant("deaf-to-flash-check", "USU is kept with the flasher's check relay down", _deaf_to_flash_check),
-    Mutant("deaf-to-doors", "signals open with screen doors open", _deaf_to_doors),
+    Mutant("deaf-to-flash-check", "USU is kept with the flasher's check relay down", _deaf_to_flash_check,
+           first="shuangxian"),
+    Mutant("deaf-to-doors", "signals open with screen doors open", _deaf_to_doors, first="shuangxian"),
     Mutant("no-64d-acceptance", "a 64D departure opens without the neighbour's acceptance", _no_64d_check),
     Mutant("64d-block-over-occupied-line", "a 64D block is given with the line's departure section occupied",
            _block_over_occupied_line),
     Mutant("station-block-ignores-neighbour", "a departure onto a station-block line opens although the neighbour "
-           "has blocked the line for its own train", _station_block_ignores_neighbour),
+           "has blocked the line for its own train", _station_block_ignores_neighbour, first="danxian"),
     Mutant("station-block-blind-to-counters", "the station block never reads the line's axle counters: a "
-           "departure opens with the line showing occupied", _station_block_blind_to_counters),
+           "departure opens with the line showing occupied", _station_block_blind_to_counters, first="danxian"),
     Mutant("line-without-block-unchecked", "a departure onto a line with no block described ignores the line's "
-           "track circuits", _line_without_block_unchecked),
+           "track circuits", _line_without_block_unchecked, first="hub:10:4"),
     Mutant("against-running-direction", "a departure against a line's running direction opens without 改方",
-           _against_running_allowed),
+           _against_running_allowed, first="shuangxian"),
     Mutant("guide-lock-ignores-doors", "the guide aspect under guide total lock ignores the screen doors",
-           _guide_lock_ignores_doors),
+           _guide_lock_ignores_doors, first="shuangxian"),
     Mutant("guide-stays-open", "the guide aspect stays lit after the guided train has entered", _guide_stays_open),
     Mutant("no-power-up-lock", "after the interlocking starts, the station is not locked", _no_power_up_lock),
     Mutant("overlap-released-at-once", "the overlap releases as soon as the train is on the receiving track",
-           _overlap_released_at_once),
+           _overlap_released_at_once, first="danxian"),
     Mutant("table-conflicts-skipped", "route setting skips the table's conflicts (only locked sections and "
            "turnouts stop it)", _table_conflicts_skipped),
     Mutant("route-over-locked-sections", "route setting ignores sections other routes hold (an overlap after its "
-           "route has released)", _route_ignores_locked_sections),
+           "route has released)", _route_ignores_locked_sections, first="danxian"),
 )

@@ -99,12 +99,19 @@ def run_mutants(stations: Iterable[str] | None = None, mutants: Iterable[Mutant]
                 soak_steps: int = SOAK_STEPS, workers: int | None = None) -> list[Caught]:
     """Try every mutant; ``workers`` processes at once (default: one per CPU), each mutant in a process of its
     own so its patches never leak into another's run."""
-    names = [m.name for m in mutants]
     chosen = list(stations or default_stations())
-    jobs = [(n, chosen, soak_steps) for n in names]
+    jobs = [(m.name, first_where_it_shows(chosen, m.first), soak_steps) for m in mutants]
     with ProcessPoolExecutor(max_workers=workers or os.cpu_count() or 1,
                              mp_context=multiprocessing.get_context("fork")) as pool:
         return list(pool.map(_one, jobs))
+
+
+def first_where_it_shows(stations: list[str], first: str) -> list[str]:
+    """``stations`` with those named ``first`` (a bundled name, a station file's name without .yaml, or a hub spec)
+    in front: every station is still tried, in the same order otherwise."""
+    def named(spec: str) -> bool:
+        return bool(first) and (spec == first or Path(spec).stem == first)
+    return sorted(stations, key=lambda spec: not named(spec))
 
 
 def report_text(results: list[Caught]) -> str:

@@ -4,12 +4,13 @@ the safety oracle, at least 95 % of them, and the report says by which check."""
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import pytest
 
 from liansuo.cli.main import main
 from liansuo.proving.mutants import MUTANTS
-from liansuo.proving.mutation import run_mutants
+from liansuo.proving.mutation import default_stations, first_where_it_shows, run_mutants
 
 
 def test_at_least_twenty_distinct_defects_and_95_percent_caught() -> None:
@@ -34,3 +35,15 @@ def test_the_mutate_command_reports_the_score(capsys: pytest.CaptureFixture[str]
     rep = json.loads(capsys.readouterr().out)
     assert rep["mutants"] == 2 and rep["caught"] == 2 and rep["score"] == 1.0
     assert {r["caught_by"] for r in rep["results"]} == {"oracle", "verify"}
+
+
+def test_each_mutant_is_tried_first_where_it_shows_and_then_everywhere_else() -> None:
+    stations = default_stations()
+    for m in [m for m in MUTANTS if m.first]:  # where a defect shows is one of the stations a run tries
+        ordered = first_where_it_shows(stations, m.first)
+        assert sorted(ordered) == sorted(stations) and m.first in (ordered[0], Path(ordered[0]).stem), m.name
+    assert first_where_it_shows(["jiaopei", "/x/danxian.yaml", "hub:10:4"], "danxian") == [
+        "/x/danxian.yaml", "jiaopei", "hub:10:4"]
+    assert first_where_it_shows(["jiaopei", "hub:10:4"], "hub:10:4") == ["hub:10:4", "jiaopei"]
+    assert first_where_it_shows(["jiaopei", "depot"], "") == ["jiaopei", "depot"]
+    assert first_where_it_shows(["jiaopei", "depot"], "nowhere") == ["jiaopei", "depot"]
