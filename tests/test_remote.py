@@ -6,13 +6,13 @@ a user drives them (Textual's Pilot)."""
 from __future__ import annotations
 
 import asyncio
-import functools
 import threading
-from collections.abc import Awaitable, Callable, Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
 import pytest
+from consoletest import SIZE, message, run
 
 from liansuo.remote.app import RemoteConsoleApp
 from liansuo.remote.dashboard import DashboardScreen
@@ -26,9 +26,6 @@ from liansuo.tui.layout import Ref
 from liansuo.tui.paint import BAND_COLOUR, glyph
 
 PASSWORD = "correct horse"
-SIZE = (120, 36)
-
-
 class Server:
     """A classroom server in a thread of its own, stopped and started again on the same port at will."""
 
@@ -77,14 +74,6 @@ def server(tmp_path: Path) -> Iterator[Server]:
         s.close()
 
 
-def run(test: Callable[..., Awaitable[None]]) -> Callable[..., None]:
-    @functools.wraps(test)
-    def wrapper(*args: Any, **kwargs: Any) -> None:
-        asyncio.run(test(*args, **kwargs))
-
-    return wrapper
-
-
 async def until(pilot: Any, condition: Callable[[], bool], seconds: float = 8.0) -> None:
     """Let the console run until ``condition`` holds (its clock takes the server's snapshots)."""
     for _ in range(int(seconds / 0.1)):
@@ -103,10 +92,6 @@ def band(app: RemoteConsoleApp, section: str) -> str:
     assert g is not None
     _, style = glyph(d.frame(), g, set())
     return str(style.color.name if style.color else "")
-
-
-def message(app: RemoteConsoleApp) -> str:
-    return str(app.message_line.content)
 
 
 def log(app: RemoteConsoleApp) -> str:

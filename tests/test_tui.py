@@ -3,14 +3,12 @@ command bar and the instructor's panel (Textual's Pilot). The clock is paused; t
 
 from __future__ import annotations
 
-import asyncio
-import functools
 import json
-from collections.abc import Awaitable, Callable
 from pathlib import Path
 from typing import Any
 
 import pytest
+from consoletest import SIZE, message, run
 
 from liansuo.tui.app import ConsoleApp
 from liansuo.tui.diagram import Diagram
@@ -20,19 +18,6 @@ from liansuo.tui.paint import BAND_COLOUR, LAMP_COLOUR, glyph
 from liansuo.tui.panels import FunctionBar
 
 EXERCISES = Path(__file__).resolve().parent.parent / "liansuo" / "exercises"
-SIZE = (120, 36)
-
-
-def run(test: Callable[..., Awaitable[None]]) -> Callable[..., None]:
-    """Run an async test body (no pytest-asyncio needed)."""
-
-    @functools.wraps(test)
-    def wrapper(*args: Any, **kwargs: Any) -> None:
-        asyncio.run(test(*args, **kwargs))
-
-    return wrapper
-
-
 async def click(pilot: Any, ref: Ref) -> None:
     await pilot.pause()  # the diagram centres itself after its first refresh (when the station is wider than it)
     diagram = pilot.app.diagram
@@ -49,10 +34,6 @@ async def function(pilot: Any, mode: str) -> None:
 def cycles(app: ConsoleApp, n: int) -> None:
     app.advance(n)
     app.refresh_views()
-
-
-def message(app: ConsoleApp) -> str:
-    return str(app.message_line.content)
 
 
 def cell(app: ConsoleApp, ref: Ref) -> tuple[str, str]:

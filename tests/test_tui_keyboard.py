@@ -5,12 +5,9 @@ muted), and hints use the station's own ids. Driven through Textual's Pilot; wha
 
 from __future__ import annotations
 
-import asyncio
-import functools
 import io
-from collections.abc import Awaitable, Callable
-from typing import Any
 
+from consoletest import SIZE, message, run
 from rich.console import Console
 from textual import events
 from textual.geometry import Region
@@ -21,16 +18,6 @@ from liansuo.tui.diagram import Diagram, nearest
 from liansuo.tui.dialogs import ConfirmScreen, HelpScreen, MenuScreen, place
 from liansuo.tui.layout import Ref
 from liansuo.tui.paint import BAND_COLOUR
-
-SIZE = (120, 36)
-
-
-def run(test: Callable[..., Awaitable[None]]) -> Callable[..., None]:
-    @functools.wraps(test)
-    def wrapper(*args: Any, **kwargs: Any) -> None:
-        asyncio.run(test(*args, **kwargs))
-
-    return wrapper
 
 
 def burst_of_keys(app: ConsoleApp, keys: list[str]) -> None:
@@ -49,10 +36,6 @@ def screen_lines(app: ConsoleApp) -> list[str]:
                       legacy_windows=False)
     console.print(app.screen._compositor.render_update(full=True, screen_stack=app._background_screens))
     return console.export_text().split("\n")[:height]
-
-
-def message(app: ConsoleApp) -> str:
-    return str(app.message_line.content)
 
 
 def outside(lines: list[str], area: Region, box: Region) -> list[str]:

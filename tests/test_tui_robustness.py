@@ -4,13 +4,12 @@ afterwards: the screen, the alarm panel, the answer line, the exit status and st
 
 from __future__ import annotations
 
-import asyncio
-import functools
 from collections.abc import Awaitable, Callable
 from pathlib import Path
 from typing import Any
 
 import pytest
+from consoletest import SIZE, message, run
 from textual import events
 from textual.app import App
 from textual.command import CommandPalette
@@ -26,16 +25,6 @@ from liansuo.tui.layout import Ref
 from liansuo.tui.operate import Operator
 from liansuo.tui.safeapp import ConsoleScreen
 
-SIZE = (120, 36)
-
-
-def run(test: Callable[..., Awaitable[None]]) -> Callable[..., None]:
-    @functools.wraps(test)
-    def wrapper(*args: Any, **kwargs: Any) -> None:
-        asyncio.run(test(*args, **kwargs))
-
-    return wrapper
-
 
 def burst_of_clicks(app: App[Any], x: int, y: int, times: int) -> None:
     """Mouse button down and up ``times`` over, all sent before the app handles the first (as a terminal delivers a
@@ -43,10 +32,6 @@ def burst_of_clicks(app: App[Any], x: int, y: int, times: int) -> None:
     for _ in range(times):
         for kind in (events.MouseDown, events.MouseUp):
             app.post_message(kind(None, x, y, 0, 0, 1, False, False, False, screen_x=x, screen_y=y))
-
-
-def shown(app: ConsoleApp) -> str:
-    return str(app.message_line.content)
 
 
 def alarm_texts(app: ConsoleApp) -> list[str]:
@@ -95,7 +80,7 @@ async def test_quitting_always_asks_by_key_by_palette_and_by_command() -> None:
         await pilot.press("ctrl+q")  # the key
         assert isinstance(app.screen, QuitScreen)
         await pilot.press("n")
-        assert app.is_running and "stays open" in shown(app)
+        assert app.is_running and "stays open" in message(app)
         await pilot.press("ctrl+p", *"quit")  # the palette's Quit (before the fix it closed the console at once)
         await pilot.pause(0.3)
         await pilot.press("enter")
@@ -233,14 +218,14 @@ async def test_run_1h_advances_in_slices_shows_its_progress_and_esc_stops_it(mon
         t0 = app.sim.t
         await pilot.press("colon", *"run 1h", "enter")  # before: the console froze until it was run
         assert t0 < app.sim.t < t0 + 3600
-        assert "run 1h" in str(app.status_bar.content) and "Esc stops it" in shown(app)
+        assert "run 1h" in str(app.status_bar.content) and "Esc stops it" in message(app)
         await pilot.press(*"route X XI")  # the screen answers while the run goes on
         assert app.command_bar.value == "route X XI" and app.long_run is not None
         await pilot.press("enter")  # one thing at a time: the route waits for the run
-        assert "wait: 'run 1h' is running" in shown(app) and app.sim.route_state("X-XI") == "released"
+        assert "wait: 'run 1h' is running" in message(app) and app.sim.route_state("X-XI") == "released"
         await pilot.press("escape")  # Esc stops it where it is
         assert app.long_run is None and t0 < app.sim.t < t0 + 3600
-        assert "'run 1h' stopped at t =" in shown(app)
+        assert "'run 1h' stopped at t =" in message(app)
         assert app.send("route X XI").ok
 
 
@@ -257,10 +242,10 @@ async def test_a_run_finishes_on_the_clock_and_is_recorded_as_cycles_that_replay
         await pilot.press("colon", *"run 45s", "enter")
         while app.long_run is not None:  # the clock's ticks, without waiting for them
             app.continue_run()
-        assert app.sim.t == pytest.approx(t0 + 45) and shown(app) == f"✓ t = {app.sim.t:g} s"
+        assert app.sim.t == pytest.approx(t0 + 45) and message(app) == f"✓ t = {app.sim.t:g} s"
         assert app.sim.aspect("X") == "U"
         assert app.send("run 9999999h").ok is False  # refused by the command language itself, at once
-        assert "a run must be from 0 to 3600 s" in shown(app)
+        assert "a run must be from 0 to 3600 s" in message(app)
     assert Replayer(load_recording(path)).verify() == []
 
 
@@ -280,7 +265,7 @@ async def test_escape_sequences_and_markup_from_a_file_are_shown_as_written(tmp_
         status = str(app.status_bar.content)
         assert "\\x1b[2J\\x1b]0;pwned\\x07教培" in status and "\x1b" not in status
         assert "[bold red]x[/] [/y]" in status  # shown as written, not as markup
-        assert "\\x1b[2J" in shown(app) and "\x1b" not in shown(app)
+        assert "\\x1b[2J" in message(app) and "\x1b" not in message(app)
         app.load_exercise(str(exercise))
         await pilot.press("f2")  # the instructor's panel shows the goal: '[/goal]' was a MarkupError before
         await pilot.pause()
