@@ -18,7 +18,7 @@ from liansuo.interlocking.tableformat import as_json
 from liansuo.proving.progress import progress
 from liansuo.proving.soakcli import soak_runs
 from liansuo.proving.verify import verify_station
-from liansuo.proving.verify.plan import cover, plan
+from liansuo.proving.verify.plan import CHAIN, Batch, by_turnouts, cover, plan
 from liansuo.stations.loader import load, load_text
 
 LIANSUO = [sys.executable, "-m", "liansuo.cli"]
@@ -39,6 +39,69 @@ def test_the_cover_proves_every_compatible_pair_exactly_once_in_groups_of_compat
         assert all(pair in edges for pair in combinations(sorted(group), 2))  # pairwise compatible
         assert all(a in group and b in group for a, b in new)
     assert cover(n, sorted(edges), max_size=size) == groups  # the same plan every time
+
+
+Groups = list[tuple[list[int], list[tuple[int, int]]]]
+
+
+def _cover_by_scanning(n: int, edges: list[tuple[int, int]], size: int) -> Groups:
+    """The cover's rule, plainly: a group starts at the vertex with the most uncovered pairs (the lowest of those
+    tied), found by looking at every vertex, and grows by the candidate of the first 32 that covers the most new
+    pairs, then keeps the most within reach."""
+    adj: list[set[int]] = [set() for _ in range(n)]
+    for a, b in edges:
+        adj[a].add(b)
+        adj[b].add(a)
+    left = [set(x) for x in adj]
+    groups: Groups = []
+    while any(left):
+        seed = max(range(n), key=lambda v: (len(left[v]), -v))
+        group, reach, useful = [seed], set(adj[seed]), set(left[seed])
+        while len(group) < size and (pool := sorted(reach & useful)):
+            best = max(pool[:32], key=lambda v: (len(left[v] & set(group)), len(left[v] & reach), -v))
+            group.append(best)
+            reach &= adj[best]
+            useful |= left[best]
+        proved: list[tuple[int, int]] = []
+        for v in group:
+            proved += [(v, w) for w in sorted(left[v] & set(group)) if v < w]
+            left[v] -= set(group)
+        groups.append((sorted(group), sorted(proved)))
+    return groups
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(2, 40).flatmap(lambda n: st.tuples(st.just(n), st.sets(
+    st.tuples(st.integers(0, n - 1), st.integers(0, n - 1)).filter(lambda e: e[0] < e[1])))),
+    st.integers(2, 8))
+def test_the_cover_follows_its_rule(graph: tuple[int, set[tuple[int, int]]], size: int) -> None:
+    n, edges = graph
+    assert cover(n, sorted(edges), max_size=size) == _cover_by_scanning(n, sorted(edges), size)
+
+
+def test_batches_are_ordered_to_move_the_fewest_turnouts_next() -> None:
+    """Each next batch of a chain is the one of the following 32 that needs the fewest turnouts moved from where the
+    chain's earlier batches left them (all normal at a chain's start), counted here name by name."""
+    table = build_table(load("gaotie"))
+    batches: list[Batch] = [b for u in plan(table, None, pairs=True).units if u.kind == "batches" for b in u.batches]
+    routes = table.routes
+
+    def needs(b: Batch) -> dict[str, str]:
+        return {t.id: t.position.value for r in b[0] for t in routes[r].all_turnouts}
+
+    shuffled = sorted(batches, key=lambda b: (len(b[0]), b[0]))
+    ordered = by_turnouts(shuffled, routes)
+    assert sorted(ordered) == sorted(shuffled)
+    left = sorted(shuffled, key=lambda b: (sorted(t for t, p in needs(b).items() if p == "reverse"),
+                                           shuffled.index(b)))
+    lie: dict[str, str] = {}
+    for i, b in enumerate(ordered):
+        if i % CHAIN == 0:
+            lie = {}
+        moves = [sum(lie.get(t, "normal") != p for t, p in needs(c).items()) for c in left[:32]]
+        assert b == left[moves.index(min(moves))]
+        left.remove(b)
+        lie.update(needs(b))
 
 
 def test_the_plan_covers_the_table_with_batches_and_counts_every_pair() -> None:

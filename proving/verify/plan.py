@@ -15,6 +15,7 @@ simulation, each cancelled before the next is set: the turnouts the next needs o
 
 from __future__ import annotations
 
+import heapq
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 
@@ -117,22 +118,33 @@ def _pairs(order: list[Route], focus: set[str] | None) -> Plan:
 def by_turnouts(batches: list[Batch], routes: dict[str, Route], window: int = 32) -> list[Batch]:
     """The batches in an order that moves few turnouts from one to the next of a chain (each chain starts with every
     turnout normal): sorted by the turnouts they need reversed, then each next one the cheapest of the following
-    ``window``. Waiting for turnouts is most of a batch's time."""
-    def needs(b: Batch) -> dict[str, str]:
-        return {t.id: t.position.value for r in b[0] for t in routes[r].all_turnouts}
-
-    wanted = [needs(b) for b in batches]
-    left = sorted(range(len(batches)), key=lambda i: (sorted(t for t, p in wanted[i].items() if p == "reverse"), i))
+    ``window``. Waiting for turnouts is most of a batch's time. The turnouts a batch needs, and those it needs
+    reversed, are bit sets (Python integers), so a move is counted with a few integer operations."""
+    bit: dict[str, int] = {}
+    needs: list[tuple[int, int]] = []  # (every turnout the batch needs, those of them reversed)
+    rev_names: list[list[str]] = []
+    for b in batches:
+        lie = {t.id: t.position.value for r in b[0] for t in routes[r].all_turnouts}
+        every = rev = 0
+        for t, p in lie.items():
+            k = bit.setdefault(t, 1 << len(bit))
+            every |= k
+            if p == "reverse":
+                rev |= k
+        needs.append((every, rev))
+        rev_names.append(sorted(t for t, p in lie.items() if p == "reverse"))
+    left = sorted(range(len(batches)), key=lambda i: (rev_names[i], i))
     out: list[int] = []
-    lie: dict[str, str] = {}
+    lying = 0  # the turnouts lying reverse now
     while left:
         if len(out) % CHAIN == 0:
-            lie = {}
+            lying = 0
         k = min(range(min(window, len(left))),
-                key=lambda j: (sum(lie.get(t, "normal") != p for t, p in wanted[left[j]].items()), j))
+                key=lambda j: (((lying ^ needs[left[j]][1]) & needs[left[j]][0]).bit_count(), j))
         i = left.pop(k)
         out.append(i)
-        lie.update(wanted[i])
+        every, rev = needs[i]
+        lying = (lying & ~every) | rev
     return [batches[i] for i in out]
 
 
@@ -149,9 +161,11 @@ def cover(n: int, edges: Iterable[tuple[int, int]], max_size: int = MAX_BATCH
         adj[b] |= 1 << a
     left = list(adj)  # uncovered edges at each vertex
     remaining = sum(x.bit_count() for x in left) // 2
+    heap = [(-x.bit_count(), v) for v, x in enumerate(left)]  # counts only fall: stale entries are pushed again
+    heapq.heapify(heap)
     groups: list[tuple[list[int], list[tuple[int, int]]]] = []
     while remaining:
-        seed = max(range(n), key=lambda v: (left[v].bit_count(), -v))
+        seed = _most_left(heap, left)
         group, members = [seed], 1 << seed
         reach = adj[seed]  # vertices adjacent to every member
         useful = left[seed]  # vertices with an uncovered edge to some member
@@ -174,6 +188,17 @@ def cover(n: int, edges: Iterable[tuple[int, int]], max_size: int = MAX_BATCH
         remaining -= len(proved)
         groups.append((sorted(group), sorted(proved)))
     return groups
+
+
+def _most_left(heap: list[tuple[int, int]], left: list[int]) -> int:
+    """The vertex with the most uncovered edges, the lowest of those tied (what ``max`` over every vertex by
+    ``(count, -vertex)`` gives), from a heap whose entries may count more than is left."""
+    while True:
+        count, v = heap[0]
+        now = left[v].bit_count()
+        if -count == now:
+            return v
+        heapq.heapreplace(heap, (-now, v))
 
 
 def _first_bits(x: int, k: int) -> list[int]:
