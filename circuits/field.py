@@ -120,6 +120,8 @@ class Field:
         """The sections that take traction current leaking through a long dead zone from now on (:mod:`.leakage`);
         their relays flicker down while it lasts (axle-counter sections are not touched)."""
         wanted = {s for s in sections if self.circuits[s].counter is None}
+        if not wanted and not self.flicker.since:
+            return  # no leakage before nor now (the common case: most stations have no long dead zone)
         for sec in self.flicker.leak(wanted, self.t):
             self._flick(sec)
 

@@ -113,20 +113,25 @@ def changed_sections(on: OnTrack, loose: dict[str, list[Shunt]], groups: Mapping
     """The sections whose shunts may differ between ``on`` and the new ``loose`` and ``groups``, leaving out those
     of ``settled`` (sections whose circuits need only know they are shunted by a standard shunt) where only the
     positions of a group's wheelsets changed, not the sections it shunts nor its resistance."""
-    out = {s for s in loose.keys() | on.loose.keys() if loose.get(s) != on.loose.get(s)}
+    was_loose = on.loose
+    out = {s for s in loose.keys() | was_loose.keys() if loose.get(s) != was_loose.get(s)} if loose or was_loose \
+        else set()
     old = on.groups
     for name, g in groups.items():
         was = old.get(name)
         if was is g:
             continue  # it has not moved
-        if was is not None and was.max_ohm == g.max_ohm and (was.sections is g.sections
-                                                              or was.sections == g.sections):
-            if not g.sections <= settled:
-                out.update(g.sections - settled)
+        now = g.sections
+        if was is None:
+            out |= now
             continue
-        out |= g.sections
-        if was is not None:
-            out |= was.sections
+        then = was.sections
+        if (then is now or then == now) and was.max_ohm == g.max_ohm:
+            if not now <= settled:
+                out.update(now - settled)
+            continue
+        out |= now
+        out |= then
     for name, was in old.items():
         if name not in groups:
             out |= was.sections

@@ -57,6 +57,7 @@ class Core:
         self.out = Outputs()
         self.now = 0.0
         self.cycles = 0
+        self.tracks_changed: set[str] = set()  # the track relays that changed, as the last cycle took them
         self.routes: dict[str, RouteState] = {}  # active routes in order of selection
         self.by_signal: dict[str, str] = {}
         st = self.station
@@ -130,6 +131,7 @@ class Core:
         self.out.changed_signals.clear()  # from here on: what this cycle changed
         self.out.changed_turnouts.clear()
         tracks, turnouts, signals, _doors, pulses = self.board.take_changes()
+        self.tracks_changed = tracks
         return Changes(tracks, turnouts, signals, pulses, commanded)
 
     def apply_inputs(self, ch: Changes) -> None:

@@ -22,7 +22,7 @@ from .aspects import is_open, stop_aspect
 from .core import Core
 from .locks import Hold
 from .route import RunOn
-from .state import GuideOnly, RouteStage, RouteState
+from .state import GuideOnly, ReleaseMemo, RouteStage, RouteState
 
 HANDLERS = {  # the method that runs a route in each stage, one cycle
     RouteStage.setting: "_setting",
@@ -42,10 +42,17 @@ class RouteLifecycle:
 
     def __init__(self, core: Core) -> None:
         self.il = core
+        self.skip_unchanged = True  # skip the release check of a route in use when nothing it reads changed
 
     # ---- the cycle ----------------------------------------------------------------------------------------------
     def advance_all(self) -> None:
-        for rs in list(self.il.routes.values()):
+        il = self.il
+        cycle, changed, in_use = il.cycles, il.tracks_changed, RouteStage.in_use
+        for rs in list(il.routes.values()):
+            memo = rs.release_memo
+            if rs.stage is in_use and memo is not None and self.skip_unchanged and memo.holds(rs, cycle, changed):
+                memo.cycle = cycle  # its release check would change nothing (ReleaseMemo)
+                continue
             self.advance(rs)
         self._guide_only()
         self._overlaps()
@@ -221,6 +228,10 @@ class RouteLifecycle:
                     self.release_section(rs, i)
         if all(rs.released):
             self.finish(rs, all_sections=False)
+        else:  # what it read, to skip it while none of that changes
+            beyond = self.beyond(rs)
+            watched = frozenset((*secs, *r.approach, beyond) if beyond is not None else (*secs, *r.approach))
+            rs.release_memo = ReleaseMemo(rs, il.cycles, watched)
 
     def beyond(self, rs: RouteState) -> str | None:
         """The section just past the route (past its run-on, where it has one)."""

@@ -34,6 +34,8 @@ class RouteState:
     overlap_release_at: float | None = None  # when the overlap releases, once the train reached the route's end
     guide_first_clear: bool = False  # under a guide aspect: the first section was clear when it opened
     guide_approach_seen: bool = False  # under a guide aspect: the guided train has been seen approaching
+    # in use: what the last release check saw, so that a cycle in which none of it changed skips it (lifecycle)
+    release_memo: ReleaseMemo | None = field(default=None, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         n = len(self.sections)
@@ -62,6 +64,32 @@ class RouteState:
     @property
     def all_turnouts(self) -> tuple[RouteTurnout, ...]:
         return self.turnouts + self.route.overlap_turnouts
+
+
+class ReleaseMemo:
+    """What the release check of a route in use (:meth:`~.lifecycle.RouteLifecycle._sequential_release`) left
+    behind: its sections' release and occupation marks, the overlap timer and the run-on, and every section whose
+    track relay it read. That check changes nothing when run again on the same marks and the same relays, so while
+    these hold and none of ``watched`` changed it need not run; ``cycle`` is the last cycle it held through, since
+    only the relays that changed in the cycle after it are known."""
+
+    __slots__ = ("cycle", "overlap_release_at", "released", "route", "run_on", "was_occupied", "watched")
+
+    def __init__(self, rs: RouteState, cycle: int, watched: frozenset[str]) -> None:
+        self.cycle = cycle
+        self.route = rs.route
+        self.run_on = rs.run_on
+        self.released = list(rs.released)
+        self.was_occupied = list(rs.was_occupied)
+        self.overlap_release_at = rs.overlap_release_at
+        self.watched = watched
+
+    def holds(self, rs: RouteState, cycle: int, changed: set[str]) -> bool:
+        """Nothing the check reads changed since it last ran, with ``changed`` the track relays that changed in
+        ``cycle``."""
+        return (self.cycle == cycle - 1 and self.watched.isdisjoint(changed) and rs.released == self.released
+                and rs.was_occupied == self.was_occupied and rs.overlap_release_at == self.overlap_release_at
+                and rs.run_on is self.run_on and rs.route is self.route)
 
 
 @dataclass

@@ -10,6 +10,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 from math import sqrt
 
@@ -17,7 +18,7 @@ from liansuo.rules import RuleSet, load_rules
 from liansuo.stations.schema import Direction, EndKind, Signal, SignalKind
 from liansuo.stations.station import Station
 
-from .movement import Position, Track
+from .movement import OUTSIDE, Position, Track
 
 
 def stopping_speed(distance_m: float, brake_ms2: float) -> float:
@@ -45,18 +46,27 @@ class Lookout:
         self.closed = rules.aspects.closed
         self.speeds_kmh = rules.driving.aspect_speed_kmh
         self.buffer_margin_m = rules.driving.buffer_margin_m
-        self._heeded: dict[tuple[str, Direction, bool], list[Signal]] = {}
+        self._heeded: dict[tuple[Direction, bool], dict[str, list[Signal]]] = {}  # by movement, then node
 
     def heeded(self, node: str, direction: Direction, shunting: bool) -> list[Signal]:
-        key = (node, direction, shunting)
-        found = self._heeded.get(key)
+        at = self.heeded_at(direction, shunting)
+        found = at.get(node)
         if found is None:
             names = self.names
-            found = self._heeded[key] = [
+            found = at[node] = [
                 sig for sig in self.station.signals_at(node) if sig.direction is direction
                 and ((sig.kind is SignalKind.shunting) == shunting
                      or (shunting and names.can_show(names.shunt, [lp.value for lp in sig.lamps])))]
         return found
+
+    def heeded_at(self, direction: Direction, shunting: bool) -> dict[str, list[Signal]]:
+        """``heeded`` of the nodes asked so far for one kind of movement, by node (a node not in it yet: ask
+        ``heeded``)."""
+        key = (direction, shunting)
+        at = self._heeded.get(key)
+        if at is None:
+            at = self._heeded[key] = {}
+        return at
 
 
 def look_ahead(track: Track, pos: Position, station: Station, aspects: dict[str, str], horizon: float,
@@ -98,4 +108,68 @@ def target_speed(current_limit_ms: float, vmax_ms: float, ahead: list[Ahead], br
             allowed = 0.0
         if allowed < v:
             v, why = allowed, a.what
+    return v, why
+
+
+def aim(track: Track, pos: Position, aspects: Mapping[str, str], lookout: Lookout, horizon: float, margin: float,
+        shunting: bool, boundary_stops: bool, current_limit_ms: float, vmax_ms: float, brake_ms2: float,
+        lead_m: float) -> tuple[float, str]:
+    """``target_speed(current_limit_ms, vmax_ms, look_ahead(...), brake_ms2, lead_m)`` in one pass: what the fleet
+    asks of every train every cycle, so no list of what lies ahead is built, nor a text for a limit that does not
+    bind. The same arithmetic in the same order, so the very same floats (tests/test_shortcuts_same.py compares them);
+    it walks the way ahead only up to the first stop, which the rails ahead (``Track``'s, kept on ``pos``) answer
+    the same however far they were worked out. Positional arguments: it is called for every train every cycle."""
+    v = min(vmax_ms, current_limit_ms)
+    why = ""
+    front = pos.moves[-1]
+    geo = track.geo.get(front[0])
+    if geo is not None and geo[2] - pos.front_s > horizon:
+        return v, why  # no node before the horizon
+    way = track.rails_ahead(pos)
+    moves, lengths, nodes = way.moves, way.lengths, way.nodes
+    direction = front[1]
+    closed, speeds_kmh, ends = lookout.closed, lookout.speeds_kmh, lookout.station.ends
+    heeded = lookout.heeded_at(direction, shunting)
+    k = 0
+    move = moves[0]
+    dist = lengths[0] - pos.front_s
+    while dist <= horizon and move[0] != OUTSIDE:
+        node = nodes[k]
+        assert node is not None
+        signals = heeded.get(node)
+        if signals is None:
+            signals = lookout.heeded(node, direction, shunting)
+        for sig in signals:
+            aspect = aspects.get(sig.id, "")
+            if aspect in closed:
+                d, speed = dist - margin, 0.0
+                allowed = sqrt(speed ** 2 + 2.0 * brake_ms2 * max(d - lead_m, 0.0))
+                if speed == 0.0 and d <= 0.5:
+                    allowed = 0.0
+                if allowed < v:
+                    v, why = allowed, f"signal {sig.id} at {aspect or 'dark'}"
+                return v, why
+            limit = speeds_kmh.get(aspect)
+            if limit is not None:
+                speed = limit / 3.6
+                allowed = sqrt(speed ** 2 + 2.0 * brake_ms2 * max(dist - lead_m, 0.0))
+                if speed == 0.0 and dist <= 0.5:
+                    allowed = 0.0
+                if allowed < v:
+                    v, why = allowed, f"signal {sig.id} at {aspect}"
+        end = ends.get(node)
+        if end is not None and (end.kind is EndKind.buffer or boundary_stops):
+            d, speed = dist - lookout.buffer_margin_m, 0.0
+            allowed = sqrt(speed ** 2 + 2.0 * brake_ms2 * max(d - lead_m, 0.0))
+            if speed == 0.0 and d <= 0.5:
+                allowed = 0.0
+            if allowed < v:
+                v, why = allowed, f"{end.kind.value} {node}"
+            return v, why
+        nxt = moves[k + 1] if k + 1 < len(moves) else track.move_after(way, k)
+        if nxt is None or nxt[0] == OUTSIDE:
+            break
+        k += 1
+        move = nxt
+        dist += lengths[k]
     return v, why

@@ -19,14 +19,15 @@ from liansuo.circuits.railgeometry import Axle
 from liansuo.rules import RuleSet, load_rules
 from liansuo.stations.schema import Direction, Marker
 from liansuo.stations.station import Station
+from liansuo.stations.topology import Move
 
 from .autoshunt import EmergencyStops
 from .cabsignal import ATP, CabReader, CabReading, CabSignal
 from .consist import Consist
-from .drivers import Lookout, look_ahead, stopping_speed, target_speed
+from .drivers import Lookout, aim, stopping_speed
 from .engine import KinematicEngine, MotionEngine
 from .movement import OUTSIDE, Notify, Position, Track
-from .odometry import Odometer
+from .odometerfeed import OdometerFeed
 from .traction import leaking_sections
 from .wheelsets import TrainWheelsets, wheelsets_now
 
@@ -67,7 +68,7 @@ class Train:
     # emergency stops by source (Liu Jing et al. 2025, docs/references.md)
     estops: EmergencyStops = field(default_factory=EmergencyStops)
     # on-board speed and distance measurement (Liu Bin et al., docs/references.md)
-    odometer: Odometer = field(default_factory=Odometer)
+    odometer: OdometerFeed = field(default_factory=OdometerFeed)  # worked out when read
     travelled_m: float = 0.0  # the true distance run since placed (what the odometer estimates)
     slip_ratio: float = 0.0  # wheel speed / true speed - 1 while an injected slip (> 0) or slide (< 0) lasts
     slip_from: float = 0.0
@@ -149,25 +150,31 @@ class Fleet:
         self.dt = dt
         targets: dict[str, float] = {}
         limits: dict[str, float] = {}
+        aspects = self.aspects()
         for tr in self.trains.values():
             if tr.state in ("derailed", "left"):
                 continue
-            target, why = self._target(tr)
+            target, why = self._target(tr, aspects)
+            if tr.mode == "auto":
+                aspects = self.aspects()  # its controller may have asked for a route: read the signals afresh
             if tr.platform_stop is not None and tr.mode != "manual":
                 target, why = self._platform(tr, target, why)
             tr.why = why
             targets[tr.name] = target
-            stop_at = self._exact_stop(tr)
-            if stop_at is not None:
-                limits[tr.name] = stop_at
+            if tr.platform_stop is not None or tr.mode == "auto":  # else it has no exact stopping point
+                stop_at = self._exact_stop(tr)
+                if stop_at is not None:
+                    limits[tr.name] = stop_at
         motion = self.engine.step(dt, targets, limits)
+        ahead = self.track.ahead
         for name, (speed, ds) in motion.items():
             moving = self.trains.get(name)
             if moving is not None:
                 accel = (speed - moving.speed_ms) / dt
                 moving.speed_ms = speed
-                self._odometry(moving, dt, ds, accel)
-                self._move(moving, ds)
+                passing = ahead(moving.pos, ds) if ds > 0 else []  # the nodes its front passes in this step
+                self._odometry(moving, dt, ds, accel, passing)
+                self._move(moving, ds, passing)
         for tr in list(self.trains.values()):
             if tr.state not in ("derailed", "left") and self.cabs.update(tr) is not None:  # its state changed
                 self._atp(tr, tr.cab.reading)
@@ -184,9 +191,10 @@ class Fleet:
         """The sections taking traction current leaking through long dead zones from the trains' wheelsets."""
         return leaking_sections(self.track, self.long_zones, self.trains.values()) if self.long_zones else set()
 
-    def _odometry(self, tr: Train, dt: float, ds: float, accel: float) -> None:
+    def _odometry(self, tr: Train, dt: float, ds: float, accel: float, passing: list[tuple[float, str, Move]]) -> None:
         """Feed the on-board odometer: the wheels turn at the train's speed, faster while slipping, slower while
-        sliding; it is corrected at balises / RFID tags and where the front crosses into the next section."""
+        sliding; it is corrected at balises / RFID tags and where the front crosses into the next section (the
+        nodes in ``passing``: ``Track.ahead`` of the front over ``ds``)."""
         slip = 0.0
         if tr.slip_ratio and self.t < tr.slip_until + SLIP_RAMP_S:
             # a slip or slide builds up and dies away over about a second rather than jumping
@@ -195,11 +203,11 @@ class Fleet:
                                                  / SLIP_RAMP_S))
         before = tr.travelled_m
         tr.travelled_m += ds
-        tr.odometer.update(dt, (ds / dt) * (1.0 + slip), accel_ms2=accel)
+        tr.odometer.update(dt, (ds / dt) * (1.0 + slip), accel)
         if ds <= 0:
             return
         v = ds / dt
-        for dist, node, _ in self.track.ahead(tr.pos, ds):
+        for dist, node, _ in passing:
             if dist > ds:
                 break
             if node in self.station.joints:  # passed (ds - dist) / v seconds before the end of this step
@@ -210,25 +218,25 @@ class Fleet:
                 if s is not None and 0.0 <= start + s < ds:
                     tr.odometer.correct(before + start + s, mk.kind.value, since_s=(ds - start - s) / v)
 
-    def _move(self, tr: Train, ds: float) -> None:
+    def _move(self, tr: Train, ds: float, passing: list[tuple[float, str, Move]]) -> None:
         c = tr.consist
         if ds <= 0.0:
             return
-        self._note_signals_passed(tr, ds)
+        self._note_signals_passed(tr, ds, passing)
         moved, stop = self.track.advance(tr.name, tr.pos, ds, self.notify)
         if stop:
             tr.speed_ms = 0.0
             self.engine.set_speed(tr.name, 0.0)
             tr.state = "derailed" if stop == "derailed" else "running"
         self.track.trim(tr.pos, c.length_m)
-        if all(mv[0] == OUTSIDE for mv in tr.pos.moves):
+        if tr.pos.moves[-1][0] == OUTSIDE and all(mv[0] == OUTSIDE for mv in tr.pos.moves):
             tr.state = "left"
             self.notify("train", f"train {tr.name} has left the station")
             self.departed[tr.name] = Departure(tr.name, tr.direction.value, tr.mode, self.t)
             self.remove(tr.name)
         del moved
 
-    def _target(self, tr: Train) -> tuple[float, str]:
+    def _target(self, tr: Train, aspects: dict[str, str]) -> tuple[float, str]:
         if tr.estops.stopped:  # an emergency stop outranks everything, the driver's traction too
             return 0.0, "emergency stop (" + ", ".join(sorted(tr.estops.active)) + ")"
         c = tr.consist
@@ -238,10 +246,9 @@ class Fleet:
         rules = self.rules.driving
         horizon = tr.speed_ms ** 2 / (2 * c.brake_ms2) + 400.0
         margin = rules.shunt_margin_m if tr.mode == "auto" else rules.stop_margin_m
-        ahead = look_ahead(self.track, tr.pos, self.station, self.aspects(), horizon, margin,
-                           shunting=tr.shunting, boundary_stops=tr.mode == "auto", rules=self.rules,
-                           lookout=self.lookout)
-        v, why = target_speed(tr.aspect_limit_ms, vmax, ahead, c.brake_ms2, lead_m=tr.speed_ms * self.dt)
+        # target_speed(look_ahead(...)) in one pass (drivers.aim)
+        v, why = aim(self.track, tr.pos, aspects, self.lookout, horizon, margin, tr.shunting, tr.mode == "auto",
+                     tr.aspect_limit_ms, vmax, c.brake_ms2, tr.speed_ms * self.dt)
         if tr.mode == "auto" and self.auto_limit is not None:
             extra = self.auto_limit(tr)
             if extra is not None and extra[0] < v:
@@ -255,11 +262,12 @@ class Fleet:
             d = self._distance_to_x(tr, ps.stop_x)
             if d is not None and d >= 0:
                 return d
-        stop = tr.extra.get("stop_at") if tr.mode == "auto" else None
+        if tr.mode != "auto":
+            return None
+        stop = tr.extra.get("stop_at")
         return float(stop) if isinstance(stop, float | int) else None
 
-    def _note_signals_passed(self, tr: Train, ds: float) -> None:
-        passing = self.track.ahead(tr.pos, ds)
+    def _note_signals_passed(self, tr: Train, ds: float, passing: list[tuple[float, str, Move]]) -> None:
         if not passing:
             return
         rules = self.rules.driving

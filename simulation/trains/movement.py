@@ -148,9 +148,11 @@ class Track:
     def advance(self, name: str, pos: Position, ds: float, notify: Notify) -> tuple[float, str]:
         """Move the front ``ds`` metres; returns (metres moved, what stopped it: '', 'buffer', 'derailed')."""
         moved = 0.0
+        geo = self.geo
         while ds > 1e-9:
             head = pos.moves[-1]
-            room = self.length(head) - pos.front_s
+            g = geo.get(head[0])  # ``length``: a track's, or the open line's
+            room = (OUTSIDE_LENGTH if g is None else g[2]) - pos.front_s
             if ds <= room:
                 pos.front_s += ds
                 return moved + ds, ""
@@ -259,11 +261,14 @@ class Track:
     def trim(self, pos: Position, length: float) -> None:
         """Forget moves wholly behind the rear of the train."""
         behind = pos.front_s
-        keep = len(pos.moves) - 1
+        moves, geo = pos.moves, self.geo
+        keep = len(moves) - 1
         while keep > 0 and behind < length:
             keep -= 1
-            behind += self.length(pos.moves[keep])
-        del pos.moves[:keep]
+            g = geo.get(moves[keep][0])  # ``length``: a track's, or the open line's
+            behind += OUTSIDE_LENGTH if g is None else g[2]
+        if keep:
+            del moves[:keep]
 
     def reverse(self, pos: Position, length: float) -> Position:
         """The same train facing the other way: its rear becomes its front."""
@@ -277,21 +282,21 @@ class Track:
         """The front's move and those after it along the rails as they lie now, each with the distance from the
         front to the move's start (negative for the front's own move)."""
         out: list[tuple[float, Move]] = []
-        way = self._rails_ahead(pos)
+        way = self.rails_ahead(pos)
         k = 0
         move = way.moves[0]
         start = -pos.front_s
         while move[0] != OUTSIDE and start <= horizon:
             out.append((start, move))
             start += way.lengths[k]
-            nxt = self._move_after(way, k)
+            nxt = self.move_after(way, k)
             if nxt is None:
                 break
             k += 1
             move = nxt
         return out
 
-    def _rails_ahead(self, pos: Position) -> RailsAhead:
+    def rails_ahead(self, pos: Position) -> RailsAhead:
         """The way ahead of the front as the rails lie now: the one kept on ``pos`` while it holds."""
         front = pos.moves[-1]
         way = pos.rails_ahead
@@ -300,7 +305,7 @@ class Track:
                                                None if front[0] == OUTSIDE else self.topo.far_node(front))
         return way
 
-    def _move_after(self, way: RailsAhead, k: int) -> Move | None:
+    def move_after(self, way: RailsAhead, k: int) -> Move | None:
         """The move after ``way.moves[k]`` along the rails (worked out now if it has not been yet), or None."""
         if k + 1 < len(way.moves):
             return way.moves[k + 1]
@@ -332,7 +337,7 @@ class Track:
         geo = self.geo.get(pos.moves[-1][0])
         if geo is not None and geo[2] - pos.front_s > horizon:
             return out  # no node before the horizon (the common case of a step's run)
-        way = self._rails_ahead(pos)
+        way = self.rails_ahead(pos)
         k = 0
         move = way.moves[0]
         dist = way.lengths[0] - pos.front_s
@@ -340,7 +345,7 @@ class Track:
             node = way.nodes[k]
             assert node is not None
             out.append((dist, node, move))
-            nxt = self._move_after(way, k)
+            nxt = self.move_after(way, k)
             if nxt is None or nxt[0] == OUTSIDE:
                 break
             k += 1

@@ -216,12 +216,14 @@ def wheelsets_now(track: Track, geometry: RailGeometry, was: TrainWheelsets | No
     if they can have changed."""
     if was is None:
         return TrainWheelsets(track, geometry, pos.front_s, footprint(track, pos, offsets, geometry), ohm)
-    if was.stands_at(pos, offsets):
-        return was
     fp = was.footprint
-    if not fp.holds(pos, offsets):
-        fp = footprint(track, pos, offsets, geometry, fp)
-    return TrainWheelsets(track, geometry, pos.front_s, fp, ohm)
+    front_s = pos.front_s
+    if offsets is fp.offsets and pos.moves == fp.moves:  # ``stands_at`` and ``Footprint.holds``, asked together
+        if front_s == was._front_s:
+            return was
+        if fp.from_s <= front_s < fp.until_s:
+            return TrainWheelsets(track, geometry, front_s, fp, ohm)
+    return TrainWheelsets(track, geometry, front_s, footprint(track, pos, offsets, geometry, fp), ohm)
 
 
 __all__ = ["EDGE_M", "Footprint", "TrainWheelsets", "footprint", "sections_shunted", "wheelsets_now"]

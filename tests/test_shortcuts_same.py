@@ -1,0 +1,211 @@
+"""The shortcuts of the trains' cycle never change what happens, each checked against the path it replaces:
+
+- a driver's target speed worked out in one pass (``drivers.aim``) against ``target_speed(look_ahead(...))``, at
+  every step of every train, also for the kinds of movement the train is not (shunting, stopping at the boundary),
+  and with the way ahead worked out afresh;
+- the release check of a route in use skipped while nothing it reads changed (``ReleaseMemo``): every skip is
+  followed by the check itself, which must then change nothing;
+- the odometer worked out only when read (``OdometerFeed``) against one fed step by step.
+
+They run on the hub full of trains of the benchmark and on every bundled example script (shunting, automatic
+shunting, guide aspects, section fault release, faults, SPAD, platform stops)."""
+
+from __future__ import annotations
+
+import random
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from liansuo.bench.trains import _Dispatcher, train_slots
+from liansuo.cli.main import main
+from liansuo.interlocking.lifecycle import RouteLifecycle
+from liansuo.interlocking.state import RouteStage
+from liansuo.interlocking.table import build_table
+from liansuo.simulation.sim import Simulation
+from liansuo.simulation.trains import fleet as fleet_module
+from liansuo.simulation.trains.drivers import Lookout, look_ahead, target_speed
+from liansuo.simulation.trains.movement import Position, Track
+from liansuo.simulation.trains.odometerfeed import MAX_PENDING, OdometerFeed
+from liansuo.simulation.trains.odometry import Odometer
+from liansuo.stations.hubgen import generate_hub
+from liansuo.stations.loader import load_text
+
+EXAMPLES = sorted((Path(__file__).parent.parent / "examples" / "scripts").glob("*.yaml"))
+
+
+def _hub_with_trains(cycles: int) -> Simulation:
+    station = load_text(generate_hub(20, 8), "<hub20>")
+    table = build_table(station)
+    sim = Simulation(station, table=table)
+    dispatchers = [_Dispatcher(sim, f"B{i + 1}", r, d) for i, (r, d) in enumerate(train_slots(table, 4))]
+    for cycle in range(cycles):
+        if cycle % 4 == 0:
+            for d in dispatchers:
+                d.tick()
+        sim.step()
+    assert sum(d.departures for d in dispatchers) > 0
+    return sim
+
+
+# ---- the driver's target in one pass -------------------------------------------------------------------------------
+class AimChecked:
+    """``drivers.aim`` as the fleet calls it, each answer compared with the reference path."""
+
+    def __init__(self) -> None:
+        self.calls = 0
+        self.bound = 0  # answers limited by something ahead (a signal, a buffer stop, the boundary)
+        self.real = fleet_module.aim
+
+    def __call__(self, track: Track, pos: Position, aspects: dict[str, str], lookout: Lookout, horizon: float,
+                 margin: float, shunting: bool, boundary_stops: bool, current_limit_ms: float, vmax_ms: float,
+                 brake_ms2: float, lead_m: float) -> tuple[float, str]:
+        got = self.real(track, pos, aspects, lookout, horizon, margin, shunting, boundary_stops, current_limit_ms,
+                        vmax_ms, brake_ms2, lead_m)
+        self.calls += 1
+        self.bound += got[1] != ""
+        fresh = Position(list(pos.moves), pos.front_s)  # nothing kept on it
+        for s, b in {(shunting, boundary_stops), (not shunting, boundary_stops), (shunting, not boundary_stops)}:
+            for p in (pos, fresh):
+                ahead = look_ahead(track, p, lookout.station, aspects, horizon, margin, shunting=s,
+                                   boundary_stops=b, lookout=lookout)
+                want = target_speed(current_limit_ms, vmax_ms, ahead, brake_ms2, lead_m=lead_m)
+                mine = self.real(track, p, aspects, lookout, horizon, margin, s, b, current_limit_ms, vmax_ms,
+                                 brake_ms2, lead_m)
+                assert repr(mine) == repr(want), (pos, s, b)  # the very same floats (and signs of zero)
+        return got
+
+
+@pytest.fixture
+def aim_checked(monkeypatch: pytest.MonkeyPatch) -> Iterator[AimChecked]:
+    checked = AimChecked()
+    monkeypatch.setattr(fleet_module, "aim", checked)
+    yield checked
+
+
+def test_the_target_in_one_pass_on_a_hub_full_of_trains(aim_checked: AimChecked) -> None:
+    _hub_with_trains(900)
+    assert aim_checked.calls > 1500 and aim_checked.bound > 50
+
+
+@pytest.mark.parametrize("script", EXAMPLES, ids=lambda p: p.stem)
+def test_the_target_in_one_pass_in_every_example_script(script: Path, aim_checked: AimChecked,
+                                                        capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["test", str(script)]) == 0
+    capsys.readouterr()
+
+
+# ---- the release check skipped while nothing it reads changed ------------------------------------------------------
+class ReleaseChecked:
+    """``RouteLifecycle.advance_all``, followed for every route whose release check it skipped by that check, which
+    must change nothing: no mark, no timer, no event, no route released."""
+
+    def __init__(self) -> None:
+        self.skipped = 0
+        self.ran = 0
+        self.real = RouteLifecycle.advance_all
+
+    def __call__(self, lc: RouteLifecycle) -> None:
+        il = lc.il
+        before = {rid: rs.release_memo for rid, rs in il.routes.items() if rs.stage is RouteStage.in_use}
+        self.real(lc)
+        for rid, memo in before.items():
+            rs = il.routes.get(rid)
+            if rs is None or memo is None or rs.release_memo is not memo or memo.cycle != il.cycles:
+                self.ran += 1
+                continue
+            self.skipped += 1
+            state = self._state(lc, rid)
+            lc._sequential_release(rs)
+            assert self._state(lc, rid) == state, (rid, il.now)
+
+    @staticmethod
+    def _state(lc: RouteLifecycle, rid: str) -> Any:
+        il = lc.il
+        rs = il.routes.get(rid)
+        marks = None if rs is None else (list(rs.released), list(rs.was_occupied), rs.overlap_release_at, rs.stage)
+        return marks, len(il.events), il.events[-1] if il.events else None, dict(il.overlap_pending)
+
+
+@pytest.fixture
+def release_checked(monkeypatch: pytest.MonkeyPatch) -> Iterator[ReleaseChecked]:
+    checked = ReleaseChecked()
+    monkeypatch.setattr(RouteLifecycle, "advance_all", lambda lc: checked(lc))
+    yield checked
+
+
+def test_release_checks_skipped_on_a_hub_full_of_trains(release_checked: ReleaseChecked) -> None:
+    _hub_with_trains(1200)
+    assert release_checked.skipped > 1000 and release_checked.ran > 20
+
+
+@pytest.mark.parametrize("script", EXAMPLES, ids=lambda p: p.stem)
+def test_release_checks_skipped_in_every_example_script(script: Path, release_checked: ReleaseChecked,
+                                                        capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["test", str(script)]) == 0
+    capsys.readouterr()
+
+
+def test_a_hub_runs_the_same_with_and_without_skipping() -> None:
+    def run(skip: bool) -> list[Any]:
+        station = load_text(generate_hub(20, 8), "<hub20>")
+        table = build_table(station)
+        sim = Simulation(station, table=table)
+        sim.interlocking.lifecycle.skip_unchanged = skip
+        dispatchers = [_Dispatcher(sim, f"B{i + 1}", r, d) for i, (r, d) in enumerate(train_slots(table, 4))]
+        seen: list[Any] = []
+        for cycle in range(1200):
+            if cycle % 4 == 0:
+                for d in dispatchers:
+                    d.tick()
+            if cycle == 700 and sim.view.routes():  # a section fault release (区故解) on a route in use
+                rv = next((r for r in sim.view.routes() if r.state == "in_use"), None)
+                if rv is not None:
+                    assert sim.command(f"fault-release {table.routes[rv.id].sections[0]}").message
+            sim.step()
+            seen.append((sorted((r.id, r.state) for r in sim.view.routes()), dict(sim.view.outputs.signals),
+                         [(t.name, t.speed_ms, t.pos.front_s) for t in sim.fleet.trains.values()]))
+        seen.append(sim.event_texts())
+        return seen
+
+    assert run(True) == run(False)
+
+
+# ---- the odometer worked out when read -----------------------------------------------------------------------------
+def _odometer_state(o: Odometer) -> Any:
+    return (o.position_m, o.speed_ms, o.slipping, o.sliding, o.t, list(o.episodes), list(o.corrections))
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_the_odometer_worked_out_when_read_is_the_one_fed_step_by_step(seed: int) -> None:
+    rng = random.Random(seed)
+    eager, feed = Odometer(), OdometerFeed()
+    v = 0.0
+    for step in range(3 * MAX_PENDING // 2):
+        v = max(0.0, v + rng.uniform(-0.4, 0.35))
+        wheel = v * (1.0 + (rng.uniform(-0.6, 0.8) if 300 < step % 900 < 340 else 0.0))  # slips and slides
+        accel = rng.uniform(-1.0, 1.0)
+        eager.update(0.25, wheel, accel_ms2=accel)
+        feed.update(0.25, wheel, accel)
+        if rng.random() < 0.02:
+            at = eager.position_m + rng.uniform(-3.0, 3.0)
+            eager.section_transition(at, since_s=0.1)
+            feed.section_transition(at, since_s=0.1)
+        if rng.random() < 0.01:
+            at = eager.position_m + 1.0
+            eager.correct(at, "balise", since_s=0.05)
+            feed.correct(at, "balise", since_s=0.05)
+        if rng.random() < 0.003:  # read now and then, else only at the end (and when too much is kept)
+            assert _odometer_state(feed.odometer) == _odometer_state(eager)
+            assert feed.pending == 0
+        assert feed.pending < MAX_PENDING
+    assert _odometer_state(feed.odometer) == _odometer_state(eager)
+    assert feed.error_m(100.0) == eager.error_m(100.0) and feed.position_m == eager.position_m
+    assert feed.episodes and feed.corrections  # it did slip or slide, and was corrected
+
+
+def test_a_step_the_odometer_could_not_take_is_refused_at_once() -> None:
+    with pytest.raises(ValueError):
+        OdometerFeed().update(0.0, 1.0)
