@@ -1,6 +1,6 @@
 """The shortcuts of the trains' cycle never change what happens, each checked against the path it replaces:
 
-- a driver's target speed worked out in one pass (``drivers.aim``) against ``target_speed(look_ahead(...))``, at
+- a driver's target speed worked out in one pass (``drivers.aim``) against the rule written plainly here, at
   every step of every train, also for the kinds of movement the train is not (shunting, stopping at the boundary),
   and with the way ahead worked out afresh;
 - the release check of a route in use skipped while nothing it reads changed (``ReleaseMemo``): every skip is
@@ -14,6 +14,8 @@ from __future__ import annotations
 
 import random
 from collections.abc import Iterator
+from dataclasses import dataclass
+from math import sqrt
 from pathlib import Path
 from typing import Any
 
@@ -26,12 +28,13 @@ from liansuo.interlocking.state import RouteStage
 from liansuo.interlocking.table import build_table
 from liansuo.simulation.sim import Simulation
 from liansuo.simulation.trains import fleet as fleet_module
-from liansuo.simulation.trains.drivers import Lookout, look_ahead, target_speed
+from liansuo.simulation.trains.drivers import Lookout
 from liansuo.simulation.trains.movement import Position, Track
 from liansuo.simulation.trains.odometerfeed import MAX_PENDING, OdometerFeed
 from liansuo.simulation.trains.odometry import Odometer
 from liansuo.stations.hubgen import generate_hub
 from liansuo.stations.loader import load_text
+from liansuo.stations.schema import EndKind
 
 EXAMPLES = sorted((Path(__file__).parent.parent / "examples" / "scripts").glob("*.yaml"))
 
@@ -51,6 +54,52 @@ def _hub_with_trains(cycles: int) -> Simulation:
 
 
 # ---- the driver's target in one pass -------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class Ahead:
+    """A thing ahead a driver must heed: the distance to it and the speed allowed there (0: stop)."""
+
+    distance_m: float
+    speed_ms: float
+    what: str
+
+
+def look_ahead(track: Track, pos: Position, lookout: Lookout, aspects: dict[str, str], horizon: float,
+               margin: float, *, shunting: bool, boundary_stops: bool) -> list[Ahead]:
+    """Signals, buffer stops and (optionally) the boundary ahead along the rails as they lie now, up to the first
+    stop: a closed signal (less ``margin``), a buffer stop or the boundary (less the buffer margin)."""
+    out: list[Ahead] = []
+    closed, speeds_kmh, ends = lookout.closed, lookout.speeds_kmh, lookout.station.ends
+    direction = pos.moves[-1][1]
+    for dist, node, _move in track.ahead(pos, horizon):
+        for sig in lookout.heeded(node, direction, shunting):
+            aspect = aspects.get(sig.id, "")
+            if aspect in closed:
+                out.append(Ahead(dist - margin, 0.0, f"signal {sig.id} at {aspect or 'dark'}"))
+                return out
+            limit = speeds_kmh.get(aspect)
+            if limit is not None:
+                out.append(Ahead(dist, limit / 3.6, f"signal {sig.id} at {aspect}"))
+        end = ends.get(node)
+        if end is not None and (end.kind is EndKind.buffer or boundary_stops):
+            out.append(Ahead(dist - lookout.buffer_margin_m, 0.0, f"{end.kind.value} {node}"))
+            return out
+    return out
+
+
+def target_speed(current_limit_ms: float, vmax_ms: float, ahead: list[Ahead], brake_ms2: float,
+                 lead_m: float) -> tuple[float, str]:
+    """The lowest of line speed, the current aspect's limit, and what lets the train meet every limit ahead."""
+    v = min(vmax_ms, current_limit_ms)
+    why = ""
+    for a in ahead:
+        allowed = sqrt(a.speed_ms ** 2 + 2.0 * brake_ms2 * max(a.distance_m - lead_m, 0.0))
+        if a.speed_ms == 0.0 and a.distance_m <= 0.5:
+            allowed = 0.0
+        if allowed < v:
+            v, why = allowed, a.what
+    return v, why
+
+
 class AimChecked:
     """``drivers.aim`` as the fleet calls it, each answer compared with the reference path."""
 
@@ -69,8 +118,7 @@ class AimChecked:
         fresh = Position(list(pos.moves), pos.front_s)  # nothing kept on it
         for s, b in {(shunting, boundary_stops), (not shunting, boundary_stops), (shunting, not boundary_stops)}:
             for p in (pos, fresh):
-                ahead = look_ahead(track, p, lookout.station, aspects, horizon, margin, shunting=s,
-                                   boundary_stops=b, lookout=lookout)
+                ahead = look_ahead(track, p, lookout, aspects, horizon, margin, shunting=s, boundary_stops=b)
                 want = target_speed(current_limit_ms, vmax_ms, ahead, brake_ms2, lead_m=lead_m)
                 mine = self.real(track, p, aspects, lookout, horizon, margin, s, b, current_limit_ms, vmax_ms,
                                  brake_ms2, lead_m)

@@ -11,10 +11,9 @@
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
 from math import sqrt
 
-from liansuo.rules import RuleSet, load_rules
+from liansuo.rules import RuleSet
 from liansuo.stations.schema import Direction, EndKind, Signal, SignalKind
 from liansuo.stations.station import Station
 
@@ -24,15 +23,6 @@ from .movement import OUTSIDE, Position, Track
 def stopping_speed(distance_m: float, brake_ms2: float) -> float:
     """The highest speed (m/s) from which the train still stops within ``distance_m``."""
     return sqrt(2.0 * brake_ms2 * max(distance_m, 0.0))
-
-
-@dataclass(frozen=True)
-class Ahead:
-    """The first thing ahead a driver must heed: the distance to it and the speed allowed there (0: stop)."""
-
-    distance_m: float
-    speed_ms: float
-    what: str
 
 
 class Lookout:
@@ -69,56 +59,18 @@ class Lookout:
         return at
 
 
-def look_ahead(track: Track, pos: Position, station: Station, aspects: dict[str, str], horizon: float,
-               margin: float, *, shunting: bool, boundary_stops: bool = False,
-               rules: RuleSet | None = None, lookout: Lookout | None = None) -> list[Ahead]:
-    """Signals, buffer stops and (optionally) the boundary ahead along the rails as they lie now. A train movement
-    is governed by train signals only; a shunting movement by shunting signals and signals with a shunting aspect,
-    and it stops before a shunting signal at stop. ``lookout``: the station sorted out for the rules (made here if
-    not given)."""
-    out: list[Ahead] = []
-    lookout = lookout or Lookout(station, rules or load_rules())
-    closed, speeds_kmh, ends = lookout.closed, lookout.speeds_kmh, station.ends
-    direction = pos.moves[-1][1]
-    for dist, node, _move in track.ahead(pos, horizon):
-        for sig in lookout.heeded(node, direction, shunting):
-            aspect = aspects.get(sig.id, "")
-            if aspect in closed:
-                out.append(Ahead(dist - margin, 0.0, f"signal {sig.id} at {aspect or 'dark'}"))
-                return out
-            limit = speeds_kmh.get(aspect)
-            if limit is not None:
-                out.append(Ahead(dist, limit / 3.6, f"signal {sig.id} at {aspect}"))
-        end = ends.get(node)
-        if end is not None and (end.kind is EndKind.buffer or boundary_stops):
-            out.append(Ahead(dist - lookout.buffer_margin_m, 0.0, f"{end.kind.value} {node}"))
-            return out
-    return out
-
-
-def target_speed(current_limit_ms: float, vmax_ms: float, ahead: list[Ahead], brake_ms2: float,
-                 lead_m: float = 0.0) -> tuple[float, str]:
-    """Speed to aim for now: the lowest of line speed, the current aspect's limit, and what lets the train meet
-    every limit ahead. ``lead_m`` (the distance run in one step) keeps the discrete steps from overshooting."""
-    v = min(vmax_ms, current_limit_ms)
-    why = ""
-    for a in ahead:
-        allowed = sqrt(a.speed_ms ** 2 + 2.0 * brake_ms2 * max(a.distance_m - lead_m, 0.0))
-        if a.speed_ms == 0.0 and a.distance_m <= 0.5:
-            allowed = 0.0
-        if allowed < v:
-            v, why = allowed, a.what
-    return v, why
-
-
 def aim(track: Track, pos: Position, aspects: Mapping[str, str], lookout: Lookout, horizon: float, margin: float,
         shunting: bool, boundary_stops: bool, current_limit_ms: float, vmax_ms: float, brake_ms2: float,
         lead_m: float) -> tuple[float, str]:
-    """``target_speed(current_limit_ms, vmax_ms, look_ahead(...), brake_ms2, lead_m)`` in one pass: what the fleet
-    asks of every train every cycle, so no list of what lies ahead is built, nor a text for a limit that does not
-    bind. The same arithmetic in the same order, so the very same floats (tests/test_shortcuts_same.py compares them);
-    it walks the way ahead only up to the first stop, which the rails ahead (``Track``'s, kept on ``pos``) answer
-    the same however far they were worked out. Positional arguments: it is called for every train every cycle."""
+    """The speed a driver aims for now: the lowest of line speed, the current aspect's limit, and what lets the train
+    meet every limit ahead (signals, a buffer stop, the boundary when ``boundary_stops``) along the rails as they lie
+    now, stopping ``margin`` before a closed signal; ``lead_m`` (the distance run in one step) keeps the discrete
+    steps from overshooting. A train movement heeds train signals only; a shunting movement shunting signals and
+    signals with a shunting aspect. Worked out in one pass: the fleet asks it of every train every cycle, so no list
+    of what lies ahead is built, nor a text for a limit that does not bind; the walk ends at the first stop, which
+    the rails ahead (``Track``'s, kept on ``pos``) answer the same however far they were worked out.
+    tests/test_shortcuts_same.py compares every answer with the rule written plainly (the list of what lies ahead,
+    then the limits one by one): the very same floats."""
     v = min(vmax_ms, current_limit_ms)
     why = ""
     front = pos.moves[-1]
