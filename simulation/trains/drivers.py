@@ -94,27 +94,18 @@ def aim(track: Track, pos: Position, aspects: Mapping[str, str], lookout: Lookou
         for sig in signals:
             aspect = aspects.get(sig.id, "")
             if aspect in closed:
-                d, speed = dist - margin, 0.0
-                allowed = sqrt(speed ** 2 + 2.0 * brake_ms2 * max(d - lead_m, 0.0))
-                if speed == 0.0 and d <= 0.5:
-                    allowed = 0.0
+                allowed = _allowed(dist - margin, 0.0, brake_ms2, lead_m)
                 if allowed < v:
                     v, why = allowed, f"signal {sig.id} at {aspect or 'dark'}"
                 return v, why
             limit = speeds_kmh.get(aspect)
             if limit is not None:
-                speed = limit / 3.6
-                allowed = sqrt(speed ** 2 + 2.0 * brake_ms2 * max(dist - lead_m, 0.0))
-                if speed == 0.0 and dist <= 0.5:
-                    allowed = 0.0
+                allowed = _allowed(dist, limit / 3.6, brake_ms2, lead_m)
                 if allowed < v:
                     v, why = allowed, f"signal {sig.id} at {aspect}"
         end = ends.get(node)
         if end is not None and (end.kind is EndKind.buffer or boundary_stops):
-            d, speed = dist - lookout.buffer_margin_m, 0.0
-            allowed = sqrt(speed ** 2 + 2.0 * brake_ms2 * max(d - lead_m, 0.0))
-            if speed == 0.0 and d <= 0.5:
-                allowed = 0.0
+            allowed = _allowed(dist - lookout.buffer_margin_m, 0.0, brake_ms2, lead_m)
             if allowed < v:
                 v, why = allowed, f"{end.kind.value} {node}"
             return v, why
@@ -125,3 +116,10 @@ def aim(track: Track, pos: Position, aspects: Mapping[str, str], lookout: Lookou
         move = nxt
         dist += lengths[k]
     return v, why
+
+
+def _allowed(distance_m: float, speed_ms: float, brake_ms2: float, lead_m: float) -> float:
+    """The highest speed now from which the train still meets ``speed_ms`` at ``distance_m`` ahead, braking at
+    ``brake_ms2`` after a step's run ``lead_m``; 0 within half a metre of a stop."""
+    allowed = sqrt(speed_ms ** 2 + 2.0 * brake_ms2 * max(distance_m - lead_m, 0.0))
+    return 0.0 if speed_ms == 0.0 and distance_m <= 0.5 else allowed
