@@ -10,6 +10,8 @@ would have held had it been fed step by step. ``MAX_PENDING`` bounds what is kep
 
 from __future__ import annotations
 
+from typing import cast
+
 from .odometry import Correction, Odometer, State
 
 MAX_PENDING = 4096  # steps noted before they are worked out anyway: about 17 simulated minutes at 0.25 s a cycle
@@ -48,13 +50,11 @@ class OdometerFeed:
     def _work_out(self) -> None:
         pending, self._pending = self._pending, []
         o = self._odometer
-        for what, a, b, c in pending:
+        for what, a, b, c in pending:  # each entry as ``update`` or ``correct`` noted it
             if what == "update":
-                assert isinstance(b, float)
-                o.update(a, b, accel_ms2=c)
+                o.update(a, cast(float, b), accel_ms2=c)
             else:
-                assert isinstance(b, str) and c is not None
-                o.correct(a, b, since_s=c)
+                o.correct(a, cast(str, b), since_s=cast(float, c))
 
     # ---- read: everything noted is worked out first -----------------------------------------------------------
     @property
