@@ -233,6 +233,12 @@ class InterlockingView:
         return TurnoutView(turnout, il.board.indication(turnout), bool(locks),
                            il.locks.why_turnout(turnout) if locks else "", mark, turnout in il.core.moving)
 
+    def driving(self) -> bool:
+        """The interlocking drives a turnout now or has moves waiting in its queue (a move ends when the turnout
+        indicates its position, or fails at the rules' ``turnout_timeout_s``)."""
+        core = self._il.core
+        return bool(core.moving or core.queue)
+
     def turnout_locked(self, turnout: str) -> bool:
         """``turnout(turnout).locked`` alone: cheaper, for readers that ask it of many turnouts every cycle."""
         require("turnout", turnout, self._turnouts, self._station)

@@ -100,3 +100,49 @@ def test_a_conflict_the_interlocking_lets_through_is_caught(monkeypatch: pytest.
     rep = verify_station("jiaopei", routes=["X-XI"])
     fail = next(f for f in rep.failures if f.check == "conflict")
     assert "conflicts with" in fail.detail and len([s for s in fail.steps if s.startswith(("route", "shunt"))]) == 2
+
+
+def test_waiting_for_nothing_to_happen_lasts_until_the_turnouts_stood_still() -> None:
+    # verify's "the signal stays closed" checks wait until the turnouts have been at rest for REST_S: a wait that
+    # ended while they still moved would look at a signal that could not have opened yet
+    from liansuo.interlocking.table import build_table
+    from liansuo.proving.verify.probe import REST_S, Context, Probe
+    from liansuo.rules import load_rules
+
+    station, rules = load("jiaopei"), load_rules("china")
+    ctx = Context(station, build_table(station, rules), rules)
+    p = Probe(ctx)
+    p.settle()
+    assert p.sim.t == REST_S  # nothing moves: the rest alone
+    p = Probe(ctx)
+    p.do("route X X3")  # turnouts 1 and 3 go reverse
+    p.settle()
+    assert p.sim.turnout_state("1")[0] == "reverse" and p.sim.turnout_state("3")[0] == "reverse"
+    assert p.sim.t < 20.0 and p.script()[-1] == f"run {p.sim.t:g}s"
+    q = Probe(ctx)  # the same again, looked at REST_S before the wait ended: the turnouts were still on their way
+    q.do("route X X3")
+    q.run(p.sim.t - REST_S)
+    assert q.sim.turnout_state("1")[0] is None and q.sim.turnout_state("3")[0] is None
+
+
+def test_a_signal_opening_over_a_turnout_without_indication_is_caught_by_its_own_check(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    # an interlocking that takes a turnout whose machine stopped for one in position, and opens without its
+    # indication: the signal opens a cycle after the machines stop, which the wait before the check must see
+    from liansuo.interlocking.state import RouteStage
+    from liansuo.proving.mutants import MUTANTS
+
+    def setting(self: RouteLifecycle, rs: object) -> None:
+        il = self.il
+        if il.now - rs.since > 1.0 and not any(t.id in il.moving or t.id in il.queue  # type: ignore[attr-defined]
+                                               for t in rs.all_turnouts):  # type: ignore[attr-defined]
+            rs.stage = RouteStage.locked  # type: ignore[attr-defined]
+            self._locked(rs)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(RouteLifecycle, "_setting", setting)
+    blind = next(m for m in MUTANTS if m.name == "blind-to-indication")
+    with blind.applied():
+        rep = verify_station("jiaopei", routes=["X-X3"], pairs=False)
+    fails = [f for f in rep.failures if f.check == "no-indication" and "without indication" in f.detail]
+    assert {f.detail.split()[1] for f in fails} == {"7", "1", "3", "5"}  # every turnout of the route
+    assert all(f.steps[0] == f"fault no-indication {f.detail.split()[1]}" for f in fails)

@@ -20,6 +20,8 @@ from liansuo.stations.station import Station
 
 from ..oracle import Watch
 
+REST_S = 2.0  # how long the turnouts must have been at rest before a wait for "nothing happens" ends
+
 
 @dataclass
 class Failure:
@@ -109,6 +111,25 @@ class Probe:
             self._cycles += 1
         self._oracle()
         return done()
+
+    def settle(self, timeout_s: float = 60.0) -> None:
+        """Run until the turnouts have been at rest for ``REST_S`` of simulated time (no switch machine running, and
+        the interlocking neither driving one nor holding a move in its queue, so a move that cannot end has failed
+        at the interlocking's own time-out), or until ``timeout_s`` passed: the wait before checking that something
+        did not happen (a signal that must stay closed). What the interlocking does once its turnouts are at rest
+        (lock the route, open the signal) it does within a cycle or two, well inside ``REST_S``; waiting on after
+        that would only show the same state again. ``timeout_s`` only bounds a wait on turnouts that never rest: the
+        rounds of moves the interlocking makes at once, each up to its time-out, end well before it."""
+        rest = max(1, round(REST_S / self.ctx.cycle_s))
+        still = 0
+        for _ in range(round(timeout_s / self.ctx.cycle_s)):
+            if still >= rest:
+                break
+            self.sim.step()
+            self._cycles += 1
+            busy = self.sim.view.driving() or self.sim.field.machines_running()
+            still = 0 if busy else still + 1
+        self._oracle()
 
     def expect(self, what: str) -> Result:
         """An ``expect`` line of the command language, kept in the script."""

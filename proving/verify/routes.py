@@ -11,7 +11,7 @@ from __future__ import annotations
 from liansuo.stations.schema import SectionRole
 
 from ..oracle.authority import Tracer
-from .probe import Probe, against_running, open_route, other, prepare, route_line, turnout_groups
+from .probe import Probe, against_running, other, prepare, route_line, turnout_groups
 from .release import ReleaseChecks
 from .routecheck import RouteCheck, RouteResult
 
@@ -136,7 +136,7 @@ class RouteTest(RouteCheck):
         p = Probe(self.ctx)
         if link.kind.value == "64d":
             p.do(route_line(r))
-            p.run(SETTLE_S)
+            p.settle()
             self.check(p.closed(r.signal) and p.state(r) == "locked", "liaison",
                        f"64D departure: signal {r.signal} shows {p.aspect(r.signal)} without the neighbour's "
                        "acceptance", p)
@@ -218,7 +218,7 @@ class RouteTest(RouteCheck):
         r = self.r
         p.do(f"occupy {section}")
         p.do(route_line(r))
-        p.run(SETTLE_S)
+        p.settle()
         self.check(p.closed(r.signal), "liaison", f"{case}: signal {r.signal} shows {p.aspect(r.signal)} with "
                    f"{what} {section} occupied", p)
         p.do(f"vacate {section}")
@@ -235,7 +235,7 @@ class RouteTest(RouteCheck):
         p.do(f"lock {t}")
         result = p.do(route_line(r))
         if wait:
-            p.run(SETTLE_S)
+            p.settle()
         self.check(not result.ok and p.closed(r.signal), "turnout-out-of-position",
                    f"turnout {t} single-locked {other(pos)}: '{route_line(r)}' was "
                    f"{'accepted' if result.ok else 'refused'} and signal {r.signal} shows {p.aspect(r.signal)}", p)
@@ -257,7 +257,7 @@ class RouteTest(RouteCheck):
         p.do(f"fault obstruction {t}")
         prepare(p, r)
         p.do(route_line(r))
-        p.run(SETTLE_S)
+        p.settle()
         return self.check(p.closed(r.signal), "turnout-obstructed", f"turnout {t} obstructed on its way {pos}: "
                           f"signal {r.signal} shows {p.aspect(r.signal)}", p) and laid
 
@@ -266,7 +266,9 @@ class RouteTest(RouteCheck):
         the repair until the operator reopens it (重复开放): :meth:`indication_lost`)."""
         r = self.r
         p.do(f"fault no-indication {t}")
-        open_route(p, r, timeout_s=SETTLE_S)
+        prepare(p, r)
+        p.do(route_line(r))
+        p.settle()
         self.check(p.closed(r.signal), "no-indication", f"turnout {t} without indication: signal {r.signal} shows "
                    f"{p.aspect(r.signal)}", p)
 
@@ -312,7 +314,7 @@ class RouteTest(RouteCheck):
         prepare(p, r)
         result = p.do(route_line(r))
         if wait:
-            p.run(SETTLE_S)
+            p.settle()
         self.check(not result.ok and p.closed(r.signal), "section-occupied",
                    f"section {s} occupied: '{route_line(r)}' was {'accepted' if result.ok else 'refused'} and "
                    f"signal {r.signal} shows {p.aspect(r.signal)}", p)
