@@ -175,14 +175,15 @@ def build_circuit(station: Station, section: str, length_m: float, max_25hz_m: f
                                  f"range ({limit:g} m): a train on it might not drop its relay, so it is held "
                                  "occupied; split it with an insulated joint")
         return circuit
-    from .zpw2000a import capacitor_positions
+    from .zpw2000a import capacitor_positions, section_layout
     from .zpwadjust import adjusted_circuit
 
     carrier = sec.carrier or "1700-1"
     caps = sec.capacitors
     length = max(length_m, 1.0)
     model = adjusted_circuit(length, carrier, capacitor_positions(station, section, length_m=length),
-                             capacitance_uF=caps.capacitance_uF if caps else None)
+                             capacitance_uF=caps.capacitance_uF if caps else None,
+                             layout=section_layout(station, section))
     return SectionCircuit(section, sec.type, length_m, model)
 
 

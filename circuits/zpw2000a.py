@@ -27,6 +27,7 @@ infinite ballast is dry ballast, with no leakage.
 from __future__ import annotations
 
 import cmath
+import dataclasses
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -140,6 +141,39 @@ class ZpwParams:
 DEFAULT_PARAMS = ZpwParams()
 
 
+# ---- line classes --------------------------------------------------------------------------------------------------
+# The ZPW-2000A of a passenger-dedicated line (客专, communication-coded) differs from the conventional one (普速,
+# relay-coded, ZpwParams' figures) in its design minimum ballast and its standard capacitors (docs/zpw2000a.md):
+PASSENGER_BALLAST_OHM_KM = 2.0  # design minimum: ballastless track stays above it (about 3 ohm*km measured)
+PASSENGER_CAPACITANCE_UF = 25.0  # every carrier
+PASSENGER_SPACING_M = (60.0, 60.0, 80.0, 80.0)  # on the line (区间), per carrier 1700, 2000, 2300, 2600 Hz
+PASSENGER_STATION_SPACING_M = 100.0  # in the station (站内)
+LAYOUTS = ("conventional", "passenger-line", "passenger-station")  # what a section's standard figures follow
+
+
+def layout_params(layout: str, carrier: str, params: ZpwParams = DEFAULT_PARAMS) -> ZpwParams:
+    """``params`` with the design minimum ballast, capacitance and capacitor spacing of a layout (:data:`LAYOUTS`):
+    ``conventional`` keeps them; ``passenger-line`` and ``passenger-station`` are the passenger-dedicated line's,
+    on the line and in the station."""
+    if layout == "conventional":
+        return params
+    if layout not in LAYOUTS:
+        raise ValueError(f"unknown ZPW-2000A layout '{layout}': use {', '.join(LAYOUTS)}")
+    spacing = PASSENGER_SPACING_M[_base_index(carrier)] if layout == "passenger-line" else PASSENGER_STATION_SPACING_M
+    return dataclasses.replace(params, ballast_ohm_km=PASSENGER_BALLAST_OHM_KM,
+                               capacitance_uF=(PASSENGER_CAPACITANCE_UF,) * 4, capacitor_spacing_m=spacing)
+
+
+def section_layout(station: Station, section_id: str) -> str:
+    """The layout of a station's ZPW-2000A section: its line class, and for a passenger-dedicated line whether it is
+    on the line (an approach, departure or block section) or in the station."""
+    section = station.sections[section_id]
+    if section.line_class is None or section.line_class.value == "conventional":
+        return "conventional"
+    on_line = section.role.value in ("approach", "departure", "block")
+    return "passenger-line" if on_line else "passenger-station"
+
+
 # ---- capacitor layout ----------------------------------------------------------------------------------------------
 def standard_positions(length_m: float, count: int | None = None, params: ZpwParams = DEFAULT_PARAMS) -> list[float]:
     """Evenly spaced with half a spacing at the ends: ``count`` of them, or by the rule (about every
@@ -157,11 +191,13 @@ def capacitor_positions(station: Station, section_id: str, params: ZpwParams = D
     """The capacitors of a section as the station file describes them (``positions``, ``count`` or ``rule``), those
     by count or rule placed over ``length_m``, the length of the circuit they go into (by default the section's
     span): placed on one length and solved on another, a track's own ``length`` would put them off the line."""
-    caps = station.sections[section_id].capacitors
+    section = station.sections[section_id]
+    caps = section.capacitors
     if caps is None:
         return []
     if caps.positions is not None:
         return sorted(caps.positions)
+    params = layout_params(section_layout(station, section_id), section.carrier or "1700-1", params)
     length = station.section_span(section_id) if length_m is None else length_m
     if caps.count is not None:
         return standard_positions(length, caps.count, params)
@@ -571,10 +607,12 @@ class ZpwTrackRelay:
 
 def section_circuit(station: Station, section_id: str, params: ZpwParams = DEFAULT_PARAMS,
                     transmitter_end: End = "upper") -> ZpwCircuit:
-    """The ZpwCircuit of a ZPW-2000A section of a station (length, carrier, capacitors from the file)."""
+    """The ZpwCircuit of a ZPW-2000A section of a station (length, carrier, capacitors from the file, the figures
+    of its layout)."""
     section = station.sections[section_id]
     if section.type.value != "zpw2000a" or section.carrier is None:
         raise ValueError(f"section {section_id} is not a ZPW-2000A section with a carrier")
+    params = layout_params(section_layout(station, section_id), section.carrier, params)
     caps = section.capacitors
     length = station.section_length(section_id)
     return ZpwCircuit(length, section.carrier, capacitor_positions(station, section_id, params, length), params,

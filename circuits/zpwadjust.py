@@ -36,11 +36,14 @@ from liansuo.rules.safeyaml import build, compose, read_file
 from .zpw2000a import (
     BASE_CARRIERS,
     DEFAULT_PARAMS,
+    LAYOUTS,
     ZpwCircuit,
     ZpwFaults,
     ZpwParams,
     capacitor_positions,
     fault_label,
+    layout_params,
+    section_layout,
     standard_positions,
     sweep_section,
 )
@@ -55,9 +58,10 @@ FAULT_MODES_CHECKED = ("open", "half", "short")
 
 @dataclass(frozen=True)
 class Row:
-    """One line of the table: sections of ``carrier`` (base frequency) with ``cable_km`` of cable, longer than
-    ``from_m`` up to ``to_m``."""
+    """One line of the table: sections of ``layout`` (:data:`~.zpw2000a.LAYOUTS`) and ``carrier`` (base frequency)
+    with ``cable_km`` of cable, longer than ``from_m`` up to ``to_m``."""
 
+    layout: str
     carrier: str
     cable_km: float
     from_m: float
@@ -71,7 +75,7 @@ class Row:
 class AdjustmentTable:
     """The table's settings (what it was derived for) and its rows."""
 
-    ballasts_ohm_km: tuple[float, ...]  # the design ballast range, sampled: the first is the design minimum
+    ballasts_ohm_km: tuple[float, ...]  # the ballasts swept, from the lowest design minimum of any layout to dry
     adjust_nominal_mV: float
     adjust_floor_mV: float
     safety_margin: float  # fraction kept below the drop level
@@ -81,19 +85,20 @@ class AdjustmentTable:
     cable_km: tuple[float, ...]
     rows: tuple[Row, ...]
 
-    @property
-    def ballast_min_ohm_km(self) -> float:
-        return self.ballasts_ohm_km[0]
+    def ballasts(self, minimum: float) -> tuple[float, ...]:
+        """The design ballast range of a layout whose design minimum is ``minimum``, as swept: the minimum, then every
+        ballast of the table above it."""
+        return (minimum, *(b for b in self.ballasts_ohm_km if b > minimum))
 
-    def row(self, carrier: str, length_m: float, cable_km: float | None = None) -> Row:
+    def row(self, carrier: str, length_m: float, cable_km: float | None = None, layout: str = "conventional") -> Row:
         """The row of a section; past the table's longest length, the last row of the carrier (not adjustable:
         :func:`check_section` reports it)."""
         base = carrier.partition("-")[0]
         cable = self.cable_km[0] if cable_km is None else cable_km
-        rows = [r for r in self.rows if r.carrier == base and math.isclose(r.cable_km, cable)]
+        rows = [r for r in self.rows if r.layout == layout and r.carrier == base and math.isclose(r.cable_km, cable)]
         if not rows:
-            raise LookupError(f"the ZPW-2000A adjustment table has no rows for carrier {base} with {cable:g} km of "
-                              f"cable (it has {', '.join(f'{c:g}' for c in self.cable_km)} km)")
+            raise LookupError(f"the ZPW-2000A adjustment table has no rows for {layout} carrier {base} with "
+                              f"{cable:g} km of cable (it has {', '.join(f'{c:g}' for c in self.cable_km)} km)")
         return next((r for r in rows if r.from_m < length_m <= r.to_m), rows[-1] if length_m > 0 else rows[0])
 
     def as_dict(self) -> dict[str, Any]:
@@ -118,8 +123,8 @@ def load_table(path: Path = TABLE_FILE) -> AdjustmentTable:
     """The table as stored (``zpwadjust.yaml`` by default)."""
     root = compose(read_file(path))
     data: dict[str, Any] = build(root).data if root is not None else {}
-    rows = tuple(Row(str(r["carrier"]), float(r["cable_km"]), float(r["from_m"]), float(r["to_m"]), int(r["level"]),
-                     float(r["adjust_mV"]), bool(r["adjustable"])) for r in data["rows"])
+    rows = tuple(Row(str(r["layout"]), str(r["carrier"]), float(r["cable_km"]), float(r["from_m"]), float(r["to_m"]),
+                     int(r["level"]), float(r["adjust_mV"]), bool(r["adjustable"])) for r in data["rows"])
     return AdjustmentTable(**_settings(data), rows=rows)
 
 
@@ -149,31 +154,41 @@ def _per_mV(length_m: float, carriers: Sequence[str], ballasts: Sequence[float],
             float(res.cab_current_mA[:, 0, 0, :].min()))
 
 
-def derive_table(settings: AdjustmentTable | None = None, params: ZpwParams = DEFAULT_PARAMS) -> AdjustmentTable:
-    """The rows for the settings of ``settings`` (default: the stored table's), from the model."""
+def derive_table(settings: AdjustmentTable | None = None, params: ZpwParams = DEFAULT_PARAMS,
+                 layouts: Sequence[str] = LAYOUTS) -> AdjustmentTable:
+    """The rows for the settings of ``settings`` (default: the stored table's), from the model, for ``layouts``."""
     s = settings or table()
-    p = dataclasses.replace(params, ballast_ohm_km=s.ballasts_ohm_km[0], transmitter_V=params.transmitter_levels_V[0])
     rows = []
-    for cable in s.cable_km:
-        for base in BASE_CARRIERS:
-            variants = [f"{base}-1", f"{base}-2"]
-            lo = 0.0
-            while lo < s.max_length_m - 1e-9:
-                hi = min(lo + s.band_m, s.max_length_m)
-                lengths = np.arange(hi, lo, -10.0)
-                worst, cab = 0.0, math.inf
-                for length in lengths:
-                    w, _, _, _, c = _per_mV(float(length), variants, s.ballasts_ohm_km, p)
-                    worst, cab = max(worst, w), min(cab, c)
-                limit = params.drop_mV / worst * (1.0 - s.safety_margin)
-                adjustable = limit >= s.adjust_floor_mV
-                adjust = math.floor(min(s.adjust_nominal_mV, limit)) if adjustable else s.adjust_floor_mV
-                need = params.cab_min(base) * (1.0 + s.cab_margin)
-                level = max((n for n, v in enumerate(params.transmitter_levels_V, start=1)
-                             if cab * v / params.transmitter_levels_V[0] >= need), default=1)
-                rows.append(Row(base, cable, lo, hi, level, float(adjust), adjustable))
-                lo = hi
+    for layout, cable, base in ((lay, c, b) for lay in layouts for c in s.cable_km for b in BASE_CARRIERS):
+        rows += _rows(s, layout, cable, base, params)
     return dataclasses.replace(s, rows=tuple(rows))
+
+
+def _rows(s: AdjustmentTable, layout: str, cable: float, base: str, params: ZpwParams) -> list[Row]:
+    """The rows of one layout, cable length and base carrier, band by band of section length."""
+    bands = np.arange(0.0, s.max_length_m, s.band_m)
+    return [derive_row(s, layout, cable, base, float(lo), float(min(lo + s.band_m, s.max_length_m)), params)
+            for lo in bands]
+
+
+def derive_row(s: AdjustmentTable, layout: str, cable: float, base: str, lo: float, hi: float,
+               params: ZpwParams = DEFAULT_PARAMS) -> Row:
+    """The row for sections of ``layout`` and ``base`` carrier (both variants) longer than ``lo`` up to ``hi``,
+    every 10 m, over the layout's design ballast range."""
+    p = dataclasses.replace(layout_params(layout, base, params), transmitter_V=params.transmitter_levels_V[0])
+    ballasts = s.ballasts(p.ballast_ohm_km)
+    variants = [f"{base}-1", f"{base}-2"]
+    worst, cab = 0.0, math.inf
+    for length in np.arange(hi, lo, -10.0):
+        w, _, _, _, c = _per_mV(float(length), variants, ballasts, p)
+        worst, cab = max(worst, w), min(cab, c)
+    limit = params.drop_mV / worst * (1.0 - s.safety_margin)
+    adjustable = limit >= s.adjust_floor_mV
+    adjust = math.floor(min(s.adjust_nominal_mV, limit)) if adjustable else s.adjust_floor_mV
+    need = params.cab_min(base) * (1.0 + s.cab_margin)
+    level = max((n for n, v in enumerate(params.transmitter_levels_V, start=1)
+                 if cab * v / params.transmitter_levels_V[0] >= need), default=1)
+    return Row(layout, base, cable, lo, hi, level, float(adjust), adjustable)
 
 
 def write_table(path: Path = TABLE_FILE) -> None:
@@ -182,10 +197,12 @@ def write_table(path: Path = TABLE_FILE) -> None:
     head = ("# ZPW-2000A adjustment table (调整表) of liansuo's model: derived by\n"
             "# liansuo.circuits.zpwadjust.derive_table from the settings above 'rows' (python -m\n"
             "# liansuo.circuits.zpwadjust rewrites it); docs/zpw2000a.md explains it. Per carrier, cable and\n"
-            "# section length (from_m exclusive, to_m inclusive): transmitter level (1-5) and the main-track output\n"
-            "# the receiver is set to at the design minimum ballast with no train (adjust_mV).\n")
+            "# section length (from_m exclusive, to_m inclusive) of each layout (conventional line, passenger-\n"
+            "# dedicated line or station): transmitter level (1-5) and the main-track output the receiver is set to\n"
+            "# at the layout's design minimum ballast with no train (adjust_mV).\n")
     body = yaml.safe_dump({k: v for k, v in t.as_dict().items() if k != "rows"}, sort_keys=False)
-    rows = "".join(f"  - {{carrier: '{r.carrier}', cable_km: {r.cable_km:g}, from_m: {r.from_m:g}, to_m: {r.to_m:g}, "
+    rows = "".join(f"  - {{layout: {r.layout}, carrier: '{r.carrier}', cable_km: {r.cable_km:g}, "
+                   f"from_m: {r.from_m:g}, to_m: {r.to_m:g}, "
                    f"level: {r.level}, adjust_mV: {r.adjust_mV:g}, adjustable: {str(r.adjustable).lower()}}}\n"
                    for r in t.rows)
     path.write_text(head + body + "rows:\n" + rows, encoding="utf-8")
@@ -193,18 +210,20 @@ def write_table(path: Path = TABLE_FILE) -> None:
 
 # ---- applying it ---------------------------------------------------------------------------------------------------
 def adjusted_params(carrier: str, length_m: float, cable_km: float | None = None,
-                    params: ZpwParams = DEFAULT_PARAMS) -> tuple[ZpwParams, Row]:
-    """``params`` with the transmitter level and receiver setting of the section's row."""
-    row = table().row(carrier, length_m, cable_km)
+                    params: ZpwParams = DEFAULT_PARAMS, layout: str = "conventional") -> tuple[ZpwParams, Row]:
+    """``params`` with the figures of the layout and the transmitter level and receiver setting of the section's
+    row."""
+    row = table().row(carrier, length_m, cable_km, layout)
+    params = layout_params(layout, carrier, params)
     return dataclasses.replace(params, transmitter_V=params.transmitter_levels_V[row.level - 1],
                                adjust_mV=row.adjust_mV), row
 
 
 def adjusted_circuit(length_m: float, carrier: str, capacitor_positions_m: Sequence[float] = (),
                      params: ZpwParams = DEFAULT_PARAMS, *, capacitance_uF: float | None = None,
-                     cable_km: float | None = None) -> ZpwCircuit:
-    """A ZpwCircuit adjusted by the table, as a maintainer leaves it."""
-    p, _ = adjusted_params(carrier, length_m, cable_km, params)
+                     cable_km: float | None = None, layout: str = "conventional") -> ZpwCircuit:
+    """A ZpwCircuit of a layout (:data:`~.zpw2000a.LAYOUTS`) adjusted by the table, as a maintainer leaves it."""
+    p, _ = adjusted_params(carrier, length_m, cable_km, params, layout)
     return ZpwCircuit(length_m, carrier, capacitor_positions_m, p, capacitance_uF=capacitance_uF)
 
 
@@ -216,7 +235,8 @@ def section_circuit(station: Station, section_id: str, params: ZpwParams = DEFAU
     caps = section.capacitors
     length = station.section_length(section_id)
     return adjusted_circuit(length, section.carrier, capacitor_positions(station, section_id, params, length), params,
-                            capacitance_uF=caps.capacitance_uF if caps else None)
+                            capacitance_uF=caps.capacitance_uF if caps else None,
+                            layout=section_layout(station, section_id))
 
 
 @dataclass(frozen=True)
@@ -255,23 +275,24 @@ class Verdict:
         return self.detects and self.picks_up
 
 
-def check_circuit(circuit: ZpwCircuit, section: str = "") -> Verdict:
-    """Sweep an adjusted circuit over the design ballast range with every single capacitor fault."""
+def check_circuit(circuit: ZpwCircuit, section: str = "", layout: str = "conventional") -> Verdict:
+    """Sweep an adjusted circuit over the design ballast range of its layout (from the design minimum its
+    parameters hold to dry) with every single capacitor fault."""
     t, p = table(), circuit.params
-    per_mV, ballast, _, fault, _ = _per_mV(circuit.length_m, [circuit.carrier], t.ballasts_ohm_km,
-                                           dataclasses.replace(p, ballast_ohm_km=t.ballast_min_ohm_km),
+    low = p.ballast_ohm_km
+    per_mV, ballast, _, fault, _ = _per_mV(circuit.length_m, [circuit.carrier], t.ballasts(low), p,
                                            circuit.capacitors_m, circuit.capacitance_uF)
-    adjust = circuit.adjustment(ZpwFaults(ballast_ohm_km=t.ballast_min_ohm_km)).voltage_mV
-    row = t.row(circuit.carrier, circuit.length_m)
-    cab = circuit.min_cab_current_mA(ZpwFaults(ballast_ohm_km=t.ballast_min_ohm_km))
+    adjust = circuit.adjustment(ZpwFaults(ballast_ohm_km=low)).voltage_mV
+    row = t.row(circuit.carrier, circuit.length_m, layout=layout)
+    cab = circuit.min_cab_current_mA(ZpwFaults(ballast_ohm_km=low))
     return Verdict(section, circuit.carrier, circuit.length_m, row.level, adjust, per_mV * adjust, ballast, fault,
-                   p.pickup_mV, p.drop_mV, t.ballast_min_ohm_km, cab, circuit.cab_min_mA)
+                   p.pickup_mV, p.drop_mV, low, cab, circuit.cab_min_mA)
 
 
 def station_verdicts(station: Station) -> list[Verdict]:
     """Every ZPW-2000A section of a station, adjusted by the table and swept."""
-    return [check_circuit(section_circuit(station, s.id), s.id) for s in station.model.sections
-            if s.type.value == "zpw2000a" and s.carrier is not None]
+    return [check_circuit(section_circuit(station, s.id), s.id, section_layout(station, s.id))
+            for s in station.model.sections if s.type.value == "zpw2000a" and s.carrier is not None]
 
 
 def _ohm_km(b: float) -> str:

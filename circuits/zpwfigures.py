@@ -73,6 +73,7 @@ def section_rows(station: Station, faults: dict[str, dict[int, str]] | None = No
         relay = "up" if adjustment.relay_up else ("marginal" if adjustment.relay_up_after(True) else "down")
         row: dict[str, Any] = {
             "id": sid, "carrier": circuit.carrier, "length_m": round(circuit.length_m, 1),
+            "ballast_ohm_km": circuit.params.ballast_ohm_km,
             "capacitors": len(circuit.capacitors_m), "adjustment_mV": round(adjustment.voltage_mV, 1),
             "max_shunt_residual_mV": round(float(residual.max()), 1),
             "min_cab_current_mA": round(float(cab.min()), 1), "cab_min_mA": circuit.cab_min_mA, "relay": relay,
@@ -97,8 +98,10 @@ def as_text(station: Station, rows: list[dict[str, Any]]) -> str:
     if not rows:
         return f"{station.id} has no ZPW-2000A sections"
     widths = (9, 8, 9, 5, 10, 13, 11, 9, 0)
+    ballasts = "/".join(f"{b:g}" for b in sorted({r["ballast_ohm_km"] for r in rows}))
     lines = [f"{station.display_name()}: ZPW-2000A sections ({P.standard_shunt_ohm:g} ohm shunt, ballast "
-             f"{P.ballast_ohm_km:g} ohm*km; relay pick-up {P.pickup_mV:g} mV, drop {P.drop_mV:g} mV)",
+             f"{ballasts} ohm*km (each section's design minimum); relay pick-up {P.pickup_mV:g} mV, drop "
+             f"{P.drop_mV:g} mV)",
              _line(("id", "carrier", "length_m", "caps", "adjust_mV", "max_resid_mV", "min_cab_mA", "relay", "fault"),
                    widths)]
     for r in rows:

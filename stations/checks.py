@@ -213,6 +213,10 @@ class _Checker:
             if caps is not None and sum(x is not None for x in (caps.count, caps.positions, caps.rule)) != 1:
                 self.err(("sections", k, "capacitors"), f"section '{s.id}': give exactly one of count, positions, rule",
                          "e.g. 'capacitors: {rule: standard}'")
+            if s.line_class is not None and s.type is not CircuitType.zpw2000a:
+                self.err(("sections", k, "line_class"),
+                         f"section '{s.id}' ({s.type.value}): a line class belongs to ZPW-2000A sections",
+                         "remove 'line_class', or make the section 'type: zpw2000a'")
             if caps is not None and s.type is not CircuitType.zpw2000a:
                 self.err(("sections", k, "capacitors"),
                          f"section '{s.id}': compensation capacitors belong to ZPW-2000A sections",

@@ -204,6 +204,13 @@ class SectionRole(StrEnum):
     spur = "spur"  # 尽头线
 
 
+class LineClass(StrEnum):
+    """Which ZPW-2000A a section has: its design minimum ballast and standard capacitors (docs/zpw2000a.md)."""
+
+    conventional = "conventional"  # 普速: relay-coded, ballast from 1.0 ohm*km, 55/50/46/40 uF about every 100 m
+    passenger = "passenger"  # 客专: communication-coded, ballast from 2.0 ohm*km, 25 uF every 60/80 m (station 100 m)
+
+
 class Capacitors(Strict):
     """Compensation capacitors (补偿电容): explicit positions (metres from the section's lower end), a count placed
     by the standard rule, or ``rule: standard`` (about every 100 m, half a spacing at the ends, only over 300 m)."""
@@ -238,6 +245,7 @@ class Section(Strict):
     carrier: Carrier | None = None
     coded: bool = False  # 电码化: carries cab-signal codes
     capacitors: Capacitors | None = None
+    line_class: LineClass | None = None  # ZPW-2000A only; none given: conventional
     speed_kmh: Speed | None = None
     name: str | None = None
 

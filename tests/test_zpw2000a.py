@@ -24,6 +24,7 @@ from liansuo.circuits.zpw2000a import (
     ZpwTrackRelay,
     capacitor_positions,
     carrier_frequency_Hz,
+    layout_params,
     section_circuit,
     single_faults,
     standard_positions,
@@ -83,8 +84,10 @@ def test_carriers_and_capacitor_layout() -> None:
 
 
 def test_capacitor_positions_from_the_station_file() -> None:
-    station = load("gaotie")
-    assert capacitor_positions(station, "X2JG") == standard_positions(1400.0)
+    station = load("gaotie")  # a passenger-dedicated line: X2JG (2300 Hz, on the line) has one every 80 m
+    assert capacitor_positions(station, "X2JG") == standard_positions(1400.0, count=18)
+    assert capacitor_positions(station, "X2JG") == standard_positions(1400.0, params=layout_params(
+        "passenger-line", "2300-1"))
     assert capacitor_positions(station, "1-7DG") == []  # no capacitors described
     text = Path(bundled()["gaotie"]).read_text(encoding="utf-8")
     text = re.sub(r"(\{id: X2JG,[^\n]*?capacitors: )\{rule: standard\}", r"\1{count: 10, capacitance_uF: 50}", text)
@@ -286,7 +289,7 @@ def test_cli_json_with_faults(capsys: pytest.CaptureFixture[str]) -> None:
     rows = {r["id"]: r for r in report["sections"]}
     assert set(rows) == set(load("gaotie").sections)
     x2 = rows["X2JG"]
-    assert x2["fault"] == "C3 open" and x2["capacitors"] == 14 and x2["length_m"] == 1400.0
+    assert x2["fault"] == "C3 open" and x2["capacitors"] == 18 and x2["length_m"] == 1400.0
     assert x2["adjustment_mV"] < x2["healthy"]["adjustment_mV"]
     assert rows["S2LQG"]["relay"] == "down" and rows["S2LQG"]["fault"] == "C1 short"
     assert rows["IAG"]["fault"] is None and rows["IAG"]["relay"] == "up" and "healthy" not in rows["IAG"]
@@ -308,7 +311,7 @@ def test_cli_csv(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
 
 
 @pytest.mark.parametrize(("spec", "message"), [
-    ("X2JG:cap:3:open", "SECTION:capacitor:N"), ("X2JG:capacitor:15:open", "capacitors 1-14"),
+    ("X2JG:cap:3:open", "SECTION:capacitor:N"), ("X2JG:capacitor:19:open", "capacitors 1-18"),
     ("X2JG:capacitor:2:melted", "open, half or short"), ("NOPE:capacitor:1:open", "no section 'NOPE'"),
     ("1-7DG:capacitor:1:open", "no compensation capacitors"), ("X2JG:capacitor:x:open", "whole number"),
 ])
