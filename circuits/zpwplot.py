@@ -141,7 +141,7 @@ def draw(station: Station, section: str, profs: Sequence[Profile], path: str) ->
     top.set_ylim(0, max(P.pickup_mV * 1.15, max(max(p.residual_mV) for p in profs) * 1.1))
     top.set_ylabel("receiver output (mV)")
     top.set_title(f"{station.id} {section}: ZPW-2000A {circuit.carrier}, {circuit.length_m:g} m, "
-                  f"{P.standard_shunt_ohm:g} ohm shunt at each point, ballast {P.ballast_ohm_km:g} ohm*km",
+                  f"{P.standard_shunt_ohm:g} ohm shunt at each point, ballast {circuit.params.ballast_ohm_km:g} ohm*km",
                   fontsize=10)
     top.legend(fontsize=7, loc="upper right", ncol=2)
     bottom.axhline(circuit.cab_min_mA, color="tab:red", linestyle="--", linewidth=1)

@@ -33,12 +33,14 @@ FAULT_TEXT = {"open": "open", "half": "-50 %"}
 
 @dataclass(frozen=True)
 class Section:
-    """One of the article's configurations: an id, the article's name, the length and the kind of ends."""
+    """One of the article's configurations: an id, the article's name, the length, the kind of ends and the layout
+    whose standard figures it has (:data:`~.zpw2000a.LAYOUTS`)."""
 
     id: str
     name: str
     length_m: float
     ends: str  # 'tuned' (the model's ZPW-2000A ends) or 'insulated' (insulated joints, no tuning unit)
+    layout: str = "conventional"
 
 
 @dataclass(frozen=True)
@@ -70,7 +72,8 @@ def _pct(value: Any) -> float | None:
 def read_article(path: Path = DATA_FILE) -> Article:
     """The article's configurations and table rows as stored in ``zpwvalidate.yaml``."""
     data = yaml.safe_load(path.read_text(encoding="utf-8"))
-    sections = tuple(Section(s["id"], s["name"], float(s["length_m"]), s["ends"]) for s in data["sections"])
+    sections = tuple(Section(s["id"], s["name"], float(s["length_m"]), s["ends"], s.get("layout", "conventional"))
+                     for s in data["sections"])
     rows = tuple(PaperRow(int(t["table"]), r["section"], t["fault"], r["quantity"], _pct(r["rise_pct"]),
                           _pct(r["fall_pct"]))
                  for t in data["tables"] for r in t["rows"])
@@ -99,29 +102,38 @@ def trend_ok(paper_rise: float | None, paper_fall: float | None, model_rise: flo
 
 def _changes(section: Section, carriers: Sequence[str], ballast: float) -> dict[str, dict[str, list[float]]]:
     """Percent change against the healthy section, per fault mode and computed quantity, over every carrier and
-    every single faulted capacitor."""
+    every single faulted capacitor. A conventional section is swept at ``ballast``; a passenger-dedicated one at its
+    own design minimum, with its layout's capacitors (which differ by carrier)."""
     import numpy as np
 
-    from .zpw2000a import DEFAULT_PARAMS, standard_positions, sweep_section
+    from .zpw2000a import layout_params, standard_positions, sweep_section
 
-    params = DEFAULT_PARAMS
-    if section.ends == "insulated":
-        params = dataclasses.replace(params, tuning_units=False)
-    caps = standard_positions(section.length_m, None, params)
-    n = len(caps)
     modes = ("open", "half")
-    cases: list[Mapping[int, str]] = [{}] + [{k: m} for m in modes for k in range(1, n + 1)]
-    result = sweep_section(section.length_m, caps, carriers, (ballast,), cases, params=params)
-    figures = {"adjustment_voltage": result.adjustment_mV[:, 0, :],
-               "min_cab_current": result.min_cab_current_mA[:, 0, :],
-               "max_shunt_residual": result.max_shunt_residual_mV[:, 0, :]}
-    if section.ends == "tuned":  # the small track is the tuning area at the transmitter end
-        figures["small_track_voltage"] = result.small_track_mV[:, 0, :]
+    per_carrier: list[dict[str, Any]] = []
+    for carrier in carriers:
+        params = layout_params(section.layout, carrier)
+        if section.ends == "insulated":
+            params = dataclasses.replace(params, tuning_units=False)
+        at = ballast if section.layout == "conventional" else params.ballast_ohm_km
+        caps = standard_positions(section.length_m, None, params)
+        n = len(caps)
+        cases: list[Mapping[int, str]] = [{}] + [{k: m} for m in modes for k in range(1, n + 1)]
+        result = sweep_section(section.length_m, caps, [carrier], (at,), cases, params=params)
+        figures = {"adjustment_voltage": result.adjustment_mV[0, 0, :],
+                   "min_cab_current": result.min_cab_current_mA[0, 0, :],
+                   "max_shunt_residual": result.max_shunt_residual_mV[0, 0, :]}
+        if section.ends == "tuned":  # the small track is the tuning area at the transmitter end
+            figures["small_track_voltage"] = result.small_track_mV[0, 0, :]
+        per_carrier.append({"n": n, "figures": figures})
     out: dict[str, dict[str, list[float]]] = {}
     for m, mode in enumerate(modes):
-        chosen = slice(1 + m * n, 1 + (m + 1) * n)
-        out[mode] = {q: [float(x) for x in np.ravel((f[:, chosen] / f[:, :1] - 1.0) * 100.0)]
-                     for q, f in figures.items()}
+        out[mode] = {}
+        for q in per_carrier[0]["figures"]:
+            values: list[float] = []
+            for c in per_carrier:
+                f, n = c["figures"][q], c["n"]
+                values += [float(x) for x in np.ravel(f[1 + m * n:1 + (m + 1) * n] / f[0] - 1.0) * 100.0]
+            out[mode][q] = values
     return out
 
 
