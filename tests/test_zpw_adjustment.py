@@ -11,6 +11,7 @@ from pathlib import Path
 
 import pytest
 
+from liansuo.circuits.cabcurrent import CabCurrents
 from liansuo.circuits.trackcircuits import build_circuit
 from liansuo.circuits.zpw2000a import LAYOUTS, ZpwFaults, layout_params, standard_positions, sweep_section
 from liansuo.circuits.zpwadjust import (
@@ -145,6 +146,11 @@ def test_a_passenger_dedicated_line_is_adjusted_with_its_own_figures(tmp_path: P
     assert len(section_circuit(station, "IG").capacitors_m) == 7  # in the station: every 100 m
     for v in station_verdicts(station):
         assert v.ok and v.feeds_cab and v.adjustment_mV == pytest.approx(240.0), v
+    cabs = CabCurrents()  # what a train's cab reads: a clean wheelset anywhere, either direction, keeps the code
+    for v in station_verdicts(station):
+        live = build_circuit(station, v.section, station.section_length(v.section))
+        for end in ("upper", "lower"):
+            assert min(cabs.profile(live, end, 0.01)[1]) >= v.cab_min_mA, (v.section, end)
     assert main(["check", "gaotie"]) == 0
     out = capsys.readouterr().out
     assert "cannot be adjusted" not in out and "longer than its transmitter feeds" not in out
