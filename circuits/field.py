@@ -27,7 +27,7 @@ from .leakage import Flicker
 from .machines import SwitchMachine
 from .railgeometry import Axle, geometry_of
 from .shunts import OnTrack, SectionShunts, Shunt, WheelsetGroup, changed_sections
-from .trackcircuits import SectionCircuit, build_circuit
+from .trackcircuits import CircuitSpec, SectionCircuit, circuit_spec
 
 
 @dataclass
@@ -51,6 +51,35 @@ class Changes:
     doors: set[str] = field(default_factory=set)
 
 
+@dataclass(frozen=True)
+class FieldPlan:
+    """What a station's field is made of, worked out once per station and rule set (:func:`field_plan`): every
+    simulation builds its own equipment from it, since every piece of equipment changes as it runs. Only values are
+    here (names, and each section's :class:`~.trackcircuits.CircuitSpec`), never a live piece."""
+
+    circuits: Mapping[str, CircuitSpec]  # by section, in the station's order
+    machines: tuple[tuple[str, str], ...]  # (turnout, switch machine type)
+    lamps: Mapping[str, tuple[str, ...]]  # signal -> its lamps
+    flashers: tuple[tuple[str, str], ...]  # (signal showing USU, the flasher the file gives it)
+    doors: tuple[str, ...]  # platform:side of every set of screen doors
+
+
+def field_plan(station: Station, rules: RuleSet) -> FieldPlan:
+    """The station's :class:`FieldPlan` under ``rules``, the same object for every field (``Station.derived``)."""
+    return station.derived(_plan, rules)
+
+
+def _plan(station: Station, rules: RuleSet) -> FieldPlan:
+    lengths = geometry_of(station).section_length
+    longest_25hz = rules.design.phase25hz_max_length_m
+    return FieldPlan(
+        {s: circuit_spec(station, s, lengths[s], longest_25hz) for s in station.sections},
+        tuple((t.id, t.machine.value) for t in station.model.turnouts),
+        {s.id: tuple(lamp.value for lamp in s.lamps) for s in station.model.signals},
+        tuple((s.id, s.flasher) for s in station.model.signals if s.usu),
+        tuple(f"{p.id}:{d.side.value}" for p in station.model.platforms for d in p.screen_doors))
+
+
 class Field:
     def __init__(self, station: Station, *, flasher: str = "auto", rules: RuleSet | None = None) -> None:
         """``rules``: the rule set whose equipment figures and flashing lamp the field has (default: the default)."""
@@ -58,25 +87,25 @@ class Field:
         rules = rules or load_rules()
         self.flasher_lamp = rules.aspects.flasher_lamp
         self.geometry = geometry_of(station)
-        longest_25hz = rules.design.phase25hz_max_length_m
-        self.circuits: dict[str, SectionCircuit] = {
-            s: build_circuit(station, s, self.geometry.section_length[s], longest_25hz) for s in station.sections}
-        self.machines = {t.id: SwitchMachine(t.id, t.machine.value, equipment=rules.equipment)
-                         for t in station.model.turnouts}
-        self.lamps = {s.id: SignalLamps([lamp.value for lamp in s.lamps]) for s in station.model.signals}
+        plan = field_plan(station, rules)
+        # every piece of equipment is this field's own, as its first evaluation left it
+        self.circuits: dict[str, SectionCircuit] = {s: SectionCircuit.settled(spec)
+                                                    for s, spec in plan.circuits.items()}
+        equipment = rules.equipment
+        self.machines = {t: SwitchMachine(t, kind, equipment=equipment) for t, kind in plan.machines}
+        self.lamps = {s: SignalLamps(names) for s, names in plan.lamps.items()}
         self.flashers: dict[str, RelayFlasher | ElectronicFlasher] = {}
-        for s in station.model.signals:
-            if s.usu:
-                kind = s.flasher if flasher == "auto" else flasher
-                self.flashers[s.id] = RelayFlasher() if kind == "relay" else ElectronicFlasher()
-        self.doors = {f"{p.id}:{d.side.value}": PlatformDoors(f"{p.id}:{d.side.value}", spec=rules.equipment.doors)
-                      for p in station.model.platforms for d in p.screen_doors}
+        for sig, own in plan.flashers:
+            kind = own if flasher == "auto" else flasher
+            self.flashers[sig] = RelayFlasher() if kind == "relay" else ElectronicFlasher()
+        self.doors = {key: PlatformDoors(key, spec=equipment.doors) for key in plan.doors}
         self.faults: dict[tuple[str, str], Fault] = {}
         self.axles: list[Axle] = []
         self.on_track = OnTrack()  # every wheelset on the track, as the field was last told (``set_axles``)
         self._shunts = {s: SectionShunts(self.on_track, s) for s in station.sections}
         self._settled: set[str] = set()  # sections whose circuits are down by a standard shunt (``shunted_down``)
-        self._listed: dict[str, list[Shunt]] = {}  # the shunts each other section was last evaluated with
+        # the shunts each other section was last evaluated with: none yet (``SectionCircuit.settled``)
+        self._listed: dict[str, list[Shunt]] = {sec: [] for sec in self.circuits}
         self.cab_codes: dict[str, str | None] = {}
         self.t = 0.0  # the field's simulated time: the sum of its steps
         self.fault_stamp = 0  # counts the faults injected and repaired: what reads the circuits can tell a change
@@ -86,9 +115,6 @@ class Field:
         self.stamp = 0  # counts the batches of changes taken: what reads the field can tell when nothing changed
         self._changes = Changes(set(station.sections), set(station.turnouts), set(station.signals),
                                 set(self.doors))
-        for sec, c in self.circuits.items():
-            c.update([])
-            self._listed[sec] = []
 
     # ---- occupancy ------------------------------------------------------------------------------------------
     def occupy(self, section: str) -> None:

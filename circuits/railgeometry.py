@@ -13,7 +13,6 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from typing import NamedTuple
-from weakref import WeakKeyDictionary
 
 from liansuo.stations.station import Station
 
@@ -36,8 +35,6 @@ class Shunt:
 
 class RailGeometry:
     def __init__(self, station: Station) -> None:
-        # The tracks, not the station: this object is the value of a cache weakly keyed by the station, and a value
-        # that held its key would keep every station ever simulated alive.
         self.tracks = station.tracks
         self.track_span = {t: station.track_span(t) for t in station.tracks}
         self.section_low: dict[str, float] = {}
@@ -92,13 +89,7 @@ class RailGeometry:
         return Shunt(sec, d, axle.ohm)
 
 
-_GEOMETRY: WeakKeyDictionary[Station, RailGeometry] = WeakKeyDictionary()
-
-
 def geometry_of(station: Station) -> RailGeometry:
-    """The station's rail geometry, worked out once per station: it never changes, and every simulation of the
-    station (verify builds thousands) reads the same."""
-    g = _GEOMETRY.get(station)
-    if g is None:
-        g = _GEOMETRY[station] = RailGeometry(station)
-    return g
+    """The station's rail geometry, worked out once per station (``Station.derived``): it never changes, and every
+    simulation of the station (verify builds thousands) reads the same."""
+    return station.derived(RailGeometry)

@@ -65,6 +65,16 @@ class SectionCircuit:
         # with 0.06 ohm, below the relay's drop level; ZPW-2000A: < 153 mV with 0.15 ohm), as their tests assert
         self.standard_shunt_ohm = 0.06 if kind is CircuitType.phase25hz else 0.15
 
+    @classmethod
+    def settled(cls, spec: CircuitSpec) -> SectionCircuit:
+        """A live circuit of its own, as ``build_circuit`` and a first ``update([])`` leave it: with nothing on the
+        track and no fault. Only its model is ``spec``'s (see :class:`CircuitSpec`); its faults, switch K, leakage
+        and axle count are its own."""
+        c = cls(spec.section, spec.kind, spec.length_m, AxleCounter() if spec.model is None else spec.model)
+        c.held_down = spec.held_down
+        c.up, c._voltage, c._cab_current_mA = spec.up, spec.voltage, spec.cab_current_mA
+        return c
+
     @property
     def voltage(self) -> float:
         """Relay-end voltage: V for 25 Hz, mV for ZPW-2000A."""
@@ -153,6 +163,36 @@ class SectionCircuit:
             self.up = zs.relay_up_after(self.up)
 
 
+@dataclass(frozen=True)
+class CircuitSpec:
+    """What the live circuit of one section is built from, and the state it settles in with nothing on the track and
+    no fault: worked out once per station and rule set (:func:`circuit_spec`) for every simulation of it, which
+    builds its own circuits from it (:meth:`SectionCircuit.settled`).
+
+    The model is shared: it is the section's physics, whose parameters are fixed when it is made (faults and shunts
+    are passed to each evaluation), and what it keeps (a ZPW-2000A model's no-train results per fault set) is a pure
+    function of what it was asked. An axle counter's count changes, so each circuit counts with an
+    :class:`~.axlecounter.AxleCounter` of its own (``model`` None)."""
+
+    section: str
+    kind: CircuitType
+    length_m: float
+    model: object | None  # Phase25HzCircuit or ZpwCircuit; None: an axle counter
+    held_down: str
+    up: bool  # the relay, the voltage and the cab current after the first evaluation
+    voltage: float
+    cab_current_mA: float | None
+
+
+def circuit_spec(station: Station, section: str, length_m: float, max_25hz_m: float = MAX_LENGTH_M
+                 ) -> CircuitSpec:
+    """The spec of ``section``'s circuit: ``build_circuit``'s, evaluated once with no shunt as a field does first."""
+    c = build_circuit(station, section, length_m, max_25hz_m)
+    c.update([])
+    return CircuitSpec(section, c.kind, c.length_m, None if c.counter is not None else c.model, c.held_down, c.up,
+                       c._voltage, c._cab_current_mA)
+
+
 def _clip(at: float | None, length: float) -> float | None:
     if at is None:
         return None
@@ -187,4 +227,4 @@ def build_circuit(station: Station, section: str, length_m: float, max_25hz_m: f
     return SectionCircuit(section, sec.type, length_m, model)
 
 
-__all__ = ["SectionCircuit", "SectionFaults", "build_circuit"]
+__all__ = ["CircuitSpec", "SectionCircuit", "SectionFaults", "build_circuit", "circuit_spec"]

@@ -43,6 +43,31 @@ class Changes:
     commanded: bool  # aspects set by operator commands since the last cycle
 
 
+class Index:
+    """What the core looks up in its station, worked out once per station (``Station.derived``) for every core of it:
+    only names and the automatic block chain, none of which changes once made (:class:`~.autoblock.AutoBlock` keeps
+    no state of its own between cycles)."""
+
+    def __init__(self, st: Station) -> None:
+        self.stop = {s.id: stop_aspect(st, s.id) for s in st.model.signals}  # each signal's stop aspect
+        # signal -> (shows USU, its stop aspect, which has a lamp of its own): what its lamp supervision needs
+        self.lamp_check = {s.id: (s.usu, self.stop[s.id], self.stop[s.id] in [lamp.value for lamp in s.lamps])
+                           for s in st.model.signals}
+        self.links = tuple((lk.id, lk.sections[0] if lk.sections else "") for lk in st.model.links
+                           if lk.kind.value == "64d")
+        self.auto_links = {lk.id: tuple(lk.sections) for lk in st.model.links if lk.kind.value == "automatic"}
+        self.station_links = tuple((lk.id, tuple(lk.sections)) for lk in st.model.links if lk.kind.value == "station")
+        self.turnouts = tuple((t, st.turnout_section[t], st.turnouts[t].trailable) for t in st.turnouts)
+        self.entry_section = {s: st.tracks[st.signal_entry_track(s)].section for s in st.signals}
+        self.signal_by_entry: dict[str, list[str]] = {}
+        for sig_id, sec in self.entry_section.items():
+            self.signal_by_entry.setdefault(sec, []).append(sig_id)
+        self.platform_doors = {p.section: [f"{p.id}:{d.side.value}" for d in p.screen_doors]
+                               for p in st.model.platforms if p.screen_doors}
+        self.autoblock = AutoBlock(st)
+        self.interlocked = tuple(name for name, section in st.sections.items() if section.role in INTERLOCKED)
+
+
 class Core:
     """One station's interlocking state. ``locked_at_start``: the state after power-up (上电): every section locked
     and every signal closed until the operator's power-up release."""
@@ -61,17 +86,16 @@ class Core:
         self.routes: dict[str, RouteState] = {}  # active routes in order of selection
         self.by_signal: dict[str, str] = {}
         st = self.station
+        index = self.index = st.derived(Index)  # read only: shared by every core of the station
         self.locks = LockLedger(st.turnout_section, st.pairs)
         self.overlap_pending: dict[str, float | None] = {}  # route -> when its overlap releases (after the route)
-        self.turnouts = {t: TurnoutState(t, st.turnout_section[t], st.turnouts[t].trailable) for t in st.turnouts}
-        self.signals = {s.id: SignalState(s.id) for s in st.model.signals}
-        for sig in st.model.signals:
-            self.out.set_aspect(sig.id, stop_aspect(st, sig.id))
-        self.links = {lk.id: BlockLink(lk.id, lk.sections[0] if lk.sections else "")
-                      for lk in st.model.links if lk.kind.value == "64d"}
-        self.auto_links = {lk.id: tuple(lk.sections) for lk in st.model.links if lk.kind.value == "automatic"}
-        self.station_links = {lk.id: StationBlockLink(lk.id, tuple(lk.sections))
-                              for lk in st.model.links if lk.kind.value == "station"}
+        self.turnouts = {t: TurnoutState(t, section, trailable) for t, section, trailable in index.turnouts}
+        self.signals = {sig: SignalState(sig) for sig in index.stop}
+        for sig, stop in index.stop.items():
+            self.out.set_aspect(sig, stop)
+        self.links = {link: BlockLink(link, section) for link, section in index.links}
+        self.auto_links = index.auto_links
+        self.station_links = {link: StationBlockLink(link, sections) for link, sections in index.station_links}
         self.axle_resets_used = 0  # the sealed axle-counter reset button's counter (计轴复零)
         self.line_out: set[str] = set()  # automatic lines whose direction is changed for our departures (改方)
         self.queue: deque[str] = deque()
@@ -81,24 +105,20 @@ class Core:
         self.guide_only: dict[str, GuideOnly] = {}  # guide aspect without a route (throat under guide total lock)
         self.events: deque[Event] = deque(maxlen=MAX_EVENTS)
         self.alarms: dict[str, Alarm] = {}
-        self.entry_section = {s: st.tracks[st.signal_entry_track(s)].section for s in st.signals}
-        self.signal_by_entry: dict[str, list[str]] = {}
-        for sig_id, sec in self.entry_section.items():
-            self.signal_by_entry.setdefault(sec, []).append(sig_id)
-        self.platform_doors = {p.section: [f"{p.id}:{d.side.value}" for d in p.screen_doors]
-                               for p in st.model.platforms if p.screen_doors}
+        self.entry_section = index.entry_section
+        self.signal_by_entry = index.signal_by_entry
+        self.platform_doors = index.platform_doors
         self._throat_platforms: dict[str, list[str]] = {}  # home signal -> platform tracks bordering its throat
         self._door_sections: dict[str, tuple[str, ...]] = {}  # route id -> door_sections(route)
-        self.autoblock = AutoBlock(st)
+        self.autoblock = index.autoblock
         self.codes_dirty = True
         self.blocks_dirty = False  # the automatic block signals must be evaluated again (a line's direction changed)
         for key in (k for keys in self.platform_doors.values() for k in keys):
             self.out.doors.setdefault(key, DoorCommand())
         self.power_up_locked = locked_at_start
         if locked_at_start:
-            for name, section in st.sections.items():
-                if section.role in INTERLOCKED:
-                    self.locks.lock_section(name, Hold.power_up)
+            for name in index.interlocked:
+                self.locks.lock_section(name, Hold.power_up)
             self.event("power", "interlocking started: every section locked until the power-up release (上电解锁)")
 
     # ---- bookkeeping --------------------------------------------------------------------------------------------
@@ -174,8 +194,8 @@ class Core:
 
     def _lamp_alarms(self, signal: str) -> None:
         """Flasher (SNJ/SNJJ), filament, lamp and red-lamp supervision of one signal whose proving relays changed."""
-        sig = self.station.signals[signal]
-        if sig.usu:
+        usu, stop, stop_lamp = self.index.lamp_check[signal]
+        if usu:
             if self.board.flasher_ok(signal):
                 if signal not in self.usu_failed:
                     self.clear_alarm("flasher", signal)
@@ -191,8 +211,7 @@ class Core:
         for key, alarm in list(self.alarms.items()):  # an aspect's lamps all proven again: its lamp alarm is over
             if alarm.kind == "lamp" and alarm.element == signal and not self._dark(signal, alarm.detail):
                 del self.alarms[key]
-        stop = stop_aspect(self.station, signal)  # the red (or blue) lamp is named as the stop aspect it shows
-        if stop in [lamp.value for lamp in sig.lamps]:
+        if stop_lamp:  # the red (or blue) lamp is named as the stop aspect it shows
             dark = not self.board.lamp_ok(signal, stop)
             if dark != self.signals[signal].red_dark:
                 self.signals[signal].red_dark = dark

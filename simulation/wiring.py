@@ -18,7 +18,7 @@ class Wiring:
         self.rules = rules
         self.field = field
         self.commands = FieldCommands()
-        self.signal_lamps = {s.id: {lamp.value for lamp in s.lamps} for s in station.model.signals}
+        self.signal_lamps = station.derived(_signal_lamps)  # read only: shared by every wiring of the station
         self._lit = False  # the first commands light every signal's lamps (the aspects set before any cycle)
 
     def relight(self) -> None:
@@ -62,3 +62,8 @@ class Wiring:
         for key in (f.doors if everything else ch.doors):
             pdkj, pdqcj = f.doors_relays(key)
             board.set_doors(key, pdkj, pdqcj)
+
+
+def _signal_lamps(station: Station) -> dict[str, set[str]]:
+    """Every signal's lamps."""
+    return {s.id: {lamp.value for lamp in s.lamps} for s in station.model.signals}

@@ -2,9 +2,10 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cached_property
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any, TypeVar, overload
 
 from .printable import printable
 from .schema import (
@@ -23,11 +24,12 @@ from .schema import (
 from .source import Diagnostic, Source
 
 if TYPE_CHECKING:
-    from liansuo.rules import DesignRules
+    from liansuo.rules import DesignRules, RuleSet
 
     from .topology import Topology
 
 LEGS = ("point", "normal", "reverse")
+T = TypeVar("T")
 
 
 @dataclass(frozen=True)
@@ -104,6 +106,35 @@ class Station:
         for turnout in model.turnouts:
             if turnout.pair:
                 self.pairs.setdefault(turnout.pair, []).append(turnout.id)
+        self._derived: dict[tuple[object, int], tuple[object, Any]] = {}  # see ``derived``
+
+    # ---- what the layers above work out from the station once ------------------------------------------------
+    @overload
+    def derived(self, make: Callable[[Station], T]) -> T: ...
+
+    @overload
+    def derived(self, make: Callable[[Station, RuleSet], T], rules: RuleSet) -> T: ...
+
+    def derived(self, make: Callable[..., T], rules: RuleSet | None = None) -> T:
+        """``make(station)`` or ``make(station, rules)``, worked out at the first call and the same object after.
+
+        A station never changes once loaded, and verify builds thousands of simulations of one: what a layer above
+        derives from the station (and a rule set) alone, such as the track circuits' models, the interlocking's
+        indices or the safety oracle's tables, is worked out for the first and read by the rest. The caller owns
+        ``make`` (a module-level function: it is the key, with the rule set by identity) and must never change what
+        it returns: whatever a simulation changes is built fresh for each. Kept on the station, it lives and dies
+        with it (a cache keyed weakly by the station could not let go of a station its values refer back to), and it
+        is not pickled: a copy in another process works it out again."""
+        key = (make, id(rules))  # the entry keeps ``rules`` alive, so its id names no other rule set meanwhile
+        hit = self._derived.get(key)
+        if hit is None:
+            hit = self._derived[key] = (rules, make(self) if rules is None else make(self, rules))
+        return hit[1]
+
+    def __getstate__(self) -> dict[str, object]:
+        state = dict(self.__dict__)
+        state["_derived"] = {}  # worked out again where it is unpickled (see ``derived``)
+        return state
 
     # ---- geometry -------------------------------------------------------------------------------------------
     def node_at(self, node: str) -> float:

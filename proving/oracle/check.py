@@ -68,18 +68,19 @@ class _Held(Extent):
     operator: bool = False  # a guide aspect over turnouts without indication: the operator answers for the route
 
 
-class Oracle:
-    def __init__(self, station: Station, rules: RuleSet, *, cycle_s: float = 0.25, reaction: int = 2) -> None:
-        self.st = station
+class Tables:
+    """What the oracle reads of a station and a rule set, worked out once per station and rule set for every oracle
+    watching a simulation of it (verify starts thousands): the tracer, the ceiling, the lamp reader and the indices
+    below never change once made (the reader's memo is a pure function of the lamps it was asked about). The flank
+    is the one piece each oracle has of its own (``Flank.fresh``): its memo is keyed by a path's tracks alone."""
+
+    def __init__(self, station: Station, rules: RuleSet) -> None:
         self.tracer = Tracer(station, overlap_release_s=rules.overlap_release_s,
                              overlap_gradient_per_mille=rules.overlap_gradient_per_mille)
         self.flank = Flank(station, clearance_m(station, rules))
-        self.aspects = rules.aspects
         self.reader = LampReader(rules.aspects)
         self.ceiling = Ceiling(station, rules)
         self.onto_track = {frozenset(pair) for pair in rules.enemy_onto_track}
-        self.cycle_s = cycle_s
-        self.reaction = reaction
         self.kind = {s.id: s.kind for s in station.model.signals}
         self.lamps = {s.id: {lamp.value for lamp in s.lamps} for s in station.model.signals}
         self.rear: dict[str, str | None] = {}
@@ -92,6 +93,29 @@ class Oracle:
         self.turnout_section = dict(station.turnout_section)
         self.turnout_tracks = {t: {tid for _, tid in station.node_tracks[t]} for t in station.turnouts}
         self.pair_of = {t.id: t.pair for t in station.model.turnouts if t.pair}
+
+
+class Oracle:
+    def __init__(self, station: Station, rules: RuleSet, *, cycle_s: float = 0.25, reaction: int = 2) -> None:
+        self.st = station
+        tables = station.derived(Tables, rules)  # read only: shared by every oracle of this station and rule set
+        self.tracer = tables.tracer
+        self.flank = tables.flank.fresh()
+        self.aspects = rules.aspects
+        self.reader = tables.reader
+        self.ceiling = tables.ceiling
+        self.onto_track = tables.onto_track
+        self.cycle_s = cycle_s
+        self.reaction = reaction
+        self.kind = tables.kind
+        self.lamps = tables.lamps
+        self.rear = tables.rear
+        self.doors = tables.doors
+        self.role = tables.role
+        self.section_of = tables.section_of
+        self.turnout_section = tables.turnout_section
+        self.turnout_tracks = tables.turnout_tracks
+        self.pair_of = tables.pair_of
         # what the oracle remembers between checks
         self.open: dict[str, Authority] = {}  # signal -> its authority at the last check
         self.shown: dict[str, str] = {}  # signal -> the proceed aspect it showed at the last check

@@ -16,6 +16,7 @@ section: a vehicle standing there fouls the path, so it must be clear.
 
 from __future__ import annotations
 
+import copy
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
@@ -54,6 +55,13 @@ class Flank:
                 reach = abs(fp.at - station.turnouts[fp.turnout].at) + clearance_m
                 self.limit[fp.turnout] = max(reach, self.limit.get(fp.turnout, 0.0))
         self._cache: dict[tuple[str, ...], tuple[dict[str, Demand], list[str]]] = {}
+
+    def fresh(self) -> Flank:
+        """A flank of its own over the same tables (they never change once made), its memo empty: the memo is keyed
+        by a path's tracks alone, so an oracle keeps it to itself, as when it built its flank."""
+        out = copy.copy(self)
+        out._cache = {}
+        return out
 
     def of(self, tracks: Sequence[str], turnouts: Mapping[str, str]) -> tuple[dict[str, Demand], list[str]]:
         """(flank turnout -> demand, fouling sections) for a path over ``tracks`` with ``turnouts`` in it."""

@@ -19,6 +19,7 @@ from .check import Finding, Oracle
 if TYPE_CHECKING:
     from liansuo.interlocking.io import Result
     from liansuo.simulation.sim import Simulation
+    from liansuo.stations.station import Station
 
 
 @dataclass(frozen=True)
@@ -41,14 +42,8 @@ class SimulationView:
     def __init__(self, sim: Simulation, rules: RuleSet | None = None) -> None:
         self.sim = sim
         self.field = sim.field
-        st = sim.station
-        names = (rules or sim.rules).aspects
-        self.stop = {s.id: frozenset(names.lamps[names.shunt_stop if s.kind.value == "shunting" else names.stop])
-                     for s in st.model.signals}  # the lamps of each signal's stop aspect
-        self.platform_keys: dict[str, list[str]] = {}
-        for p in st.model.platforms:
-            for d in p.screen_doors:
-                self.platform_keys.setdefault(p.section, []).append(f"{p.id}:{d.side.value}")
+        # read only: shared by every view of a simulation of this station under these rules
+        self.stop, self.platform_keys = sim.station.derived(_view_tables, rules or sim.rules)
         self._wheelsets: tuple[float, list[tuple[str, float]]] | None = None
 
     def showing(self) -> list[str]:
@@ -125,6 +120,18 @@ class SimulationView:
 
     def line_outbound(self, link: str) -> bool:
         return self.sim.line_outbound(link)
+
+
+def _view_tables(st: Station, rules: RuleSet) -> tuple[dict[str, frozenset[str]], dict[str, list[str]]]:
+    """The lamps of each signal's stop aspect, and the screen doors (platform:side) of each platform section."""
+    names = rules.aspects
+    stop = {s.id: frozenset(names.lamps[names.shunt_stop if s.kind.value == "shunting" else names.stop])
+            for s in st.model.signals}
+    platform_keys: dict[str, list[str]] = {}
+    for p in st.model.platforms:
+        for d in p.screen_doors:
+            platform_keys.setdefault(p.section, []).append(f"{p.id}:{d.side.value}")
+    return stop, platform_keys
 
 
 class Watch:

@@ -14,7 +14,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from liansuo.circuits.field import Field
-from liansuo.circuits.leakage import long_dead_zones
+from liansuo.circuits.leakage import LongDeadZone, long_dead_zones
 from liansuo.circuits.railgeometry import Axle
 from liansuo.rules import RuleSet, load_rules
 from liansuo.stations.schema import Direction, Marker
@@ -100,6 +100,16 @@ class Departure:
     t: float  # when its last wheelset left
 
 
+def _lineside(station: Station, rules: RuleSet) -> tuple[dict[str, list[LongDeadZone]], dict[str, list[Marker]]]:
+    """What trains meet along the track: the long dead zones by track, and the balises and RFID tags by track, in
+    the station's order."""
+    tags: dict[str, list[Marker]] = {}
+    for mk in station.model.markers:
+        if mk.kind.value in ("balise", "rfid"):
+            tags.setdefault(mk.track, []).append(mk)
+    return long_dead_zones(station, rules.design.dead_zone_long_m), tags
+
+
 class Fleet:
     """Every train of one simulation."""
 
@@ -113,12 +123,9 @@ class Fleet:
         self.field = fld
         self.track = Track(station, fld)
         self.lookout = Lookout(station, self.rules)  # what drivers look out for, sorted out once
-        self.long_zones = long_dead_zones(station, self.rules.design.dead_zone_long_m)  # by track
+        # long dead zones by track, balises and RFID tags by track: read only, shared by every fleet of the station
+        self.long_zones, self.tags = station.derived(_lineside, self.rules)
         self.cabs = CabReader(station, fld, self.track, self.long_zones, WHEEL_OHM)
-        self.tags: dict[str, list[Marker]] = {}  # balises and RFID tags by track, in the station's order
-        for mk in station.model.markers:
-            if mk.kind.value in ("balise", "rfid"):
-                self.tags.setdefault(mk.track, []).append(mk)
         self.aspects = aspects
         self.notify = notify
         self.trains: dict[str, Train] = {}

@@ -56,6 +56,10 @@ class RailsAhead:
         return not self.consulted or all(machine.rails == rails for machine, rails in self.consulted)
 
 
+def _track_geo(station: Station) -> dict[str, tuple[float, float, float]]:
+    return {t: (*station.track_span(t), station.track_length(t)) for t in station.tracks}
+
+
 class Track:
     """Geometry queries shared by all trains of a station."""
 
@@ -63,8 +67,9 @@ class Track:
         self.station = station
         self.topo = station.topology
         self.field = fld
-        # per track: (position at its low end, at its high end, length), for the hot path of wheelset positions
-        self.geo = {t: (*station.track_span(t), station.track_length(t)) for t in station.tracks}
+        # per track: (position at its low end, at its high end, length), for the hot path of wheelset positions;
+        # read only, shared by every simulation of the station
+        self.geo = station.derived(_track_geo)
 
     def length(self, move: Move) -> float:
         return OUTSIDE_LENGTH if move[0] == OUTSIDE else self.station.track_length(move[0])
