@@ -13,7 +13,6 @@ shunting, guide aspects, section fault release, faults, SPAD, platform stops).""
 from __future__ import annotations
 
 import random
-from collections.abc import Iterator
 from dataclasses import dataclass
 from math import sqrt
 from pathlib import Path
@@ -126,23 +125,16 @@ class AimChecked:
         return got
 
 
-@pytest.fixture
-def aim_checked(monkeypatch: pytest.MonkeyPatch) -> Iterator[AimChecked]:
+def _aim_checked(monkeypatch: pytest.MonkeyPatch) -> AimChecked:
     checked = AimChecked()
     monkeypatch.setattr(fleet_module, "aim", checked)
-    yield checked
+    return checked
 
 
-def test_the_target_in_one_pass_on_a_hub_full_of_trains(aim_checked: AimChecked) -> None:
+def test_the_target_in_one_pass_on_a_hub_full_of_trains(monkeypatch: pytest.MonkeyPatch) -> None:
+    checked = _aim_checked(monkeypatch)
     _hub_with_trains(900)
-    assert aim_checked.calls > 1500 and aim_checked.bound > 50
-
-
-@pytest.mark.parametrize("script", EXAMPLES, ids=lambda p: p.stem)
-def test_the_target_in_one_pass_in_every_example_script(script: Path, aim_checked: AimChecked,
-                                                        capsys: pytest.CaptureFixture[str]) -> None:
-    assert main(["test", str(script)]) == 0
-    capsys.readouterr()
+    assert checked.calls > 1500 and checked.bound > 50
 
 
 # ---- the release check skipped while nothing it reads changed ------------------------------------------------------
@@ -177,21 +169,25 @@ class ReleaseChecked:
         return marks, len(il.events), il.events[-1] if il.events else None, dict(il.overlap_pending)
 
 
-@pytest.fixture
-def release_checked(monkeypatch: pytest.MonkeyPatch) -> Iterator[ReleaseChecked]:
+def _release_checked(monkeypatch: pytest.MonkeyPatch) -> ReleaseChecked:
     checked = ReleaseChecked()
     monkeypatch.setattr(RouteLifecycle, "advance_all", lambda lc: checked(lc))
-    yield checked
+    return checked
 
 
-def test_release_checks_skipped_on_a_hub_full_of_trains(release_checked: ReleaseChecked) -> None:
+def test_release_checks_skipped_on_a_hub_full_of_trains(monkeypatch: pytest.MonkeyPatch) -> None:
+    checked = _release_checked(monkeypatch)
     _hub_with_trains(1200)
-    assert release_checked.skipped > 1000 and release_checked.ran > 20
+    assert checked.skipped > 1000 and checked.ran > 20
 
 
+@pytest.mark.parametrize("watch", [_aim_checked, _release_checked], ids=["aim", "release"])
 @pytest.mark.parametrize("script", EXAMPLES, ids=lambda p: p.stem)
-def test_release_checks_skipped_in_every_example_script(script: Path, release_checked: ReleaseChecked,
-                                                        capsys: pytest.CaptureFixture[str]) -> None:
+def test_each_shortcut_matches_its_plain_path_in_every_example_script(
+        script: Path, watch: Any, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
+    """The drivers' target and the skipped release checks, followed by their plain paths through every example
+    script (each check asserts as it goes)."""
+    watch(monkeypatch)
     assert main(["test", str(script)]) == 0
     capsys.readouterr()
 
