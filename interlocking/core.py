@@ -39,6 +39,7 @@ class Changes:
     tracks: set[str]
     turnouts: set[str]
     signals: set[str]
+    doors: set[str]
     pulses: dict[str, set[str]]
     commanded: bool  # aspects set by operator commands since the last cycle
 
@@ -82,7 +83,8 @@ class Core:
         self.out = Outputs()
         self.now = 0.0
         self.cycles = 0
-        self.tracks_changed: set[str] = set()  # the track relays that changed, as the last cycle took them
+        # the relays that changed, as the last cycle took them: what the routes' memos (lifecycle) are checked against
+        self.changes = Changes(set(), set(), set(), set(), {}, False)
         self.routes: dict[str, RouteState] = {}  # active routes in order of selection
         self.by_signal: dict[str, str] = {}
         st = self.station
@@ -150,9 +152,8 @@ class Core:
         commanded = bool(self.out.changed_signals)
         self.out.changed_signals.clear()  # from here on: what this cycle changed
         self.out.changed_turnouts.clear()
-        tracks, turnouts, signals, _doors, pulses = self.board.take_changes()
-        self.tracks_changed = tracks
-        return Changes(tracks, turnouts, signals, pulses, commanded)
+        self.changes = Changes(*self.board.take_changes(), commanded)
+        return self.changes
 
     def apply_inputs(self, ch: Changes) -> None:
         """The 64D and station-block lines, turnout indications, lamp proving and the turnout move queue."""

@@ -21,8 +21,8 @@ from __future__ import annotations
 from .aspects import is_open, stop_aspect
 from .core import Core
 from .locks import Hold
-from .route import RunOn
-from .state import GuideOnly, ReleaseMemo, RouteStage, RouteState
+from .route import Route, RunOn
+from .state import GuideOnly, OpenMemo, ReleaseMemo, RouteStage, RouteState, SettingMemo
 
 HANDLERS = {  # the method that runs a route in each stage, one cycle
     RouteStage.setting: "_setting",
@@ -33,6 +33,7 @@ HANDLERS = {  # the method that runs a route in each stage, one cycle
     RouteStage.in_use: "_sequential_release",
     RouteStage.time_release: "_time_release",
 }
+_Reads = tuple[frozenset[str], frozenset[str], frozenset[str]]  # sections, signals, screen doors
 # stages in which the signal has been opened: a train approaching makes the route approach-locked (接近锁闭)
 SIGNAL_GIVEN = frozenset({RouteStage.open, RouteStage.guide, RouteStage.closed, RouteStage.time_release})
 
@@ -42,20 +43,44 @@ class RouteLifecycle:
 
     def __init__(self, core: Core) -> None:
         self.il = core
-        self.skip_unchanged = True  # skip the release check of a route in use when nothing it reads changed
+        self.skip_unchanged = True  # skip a route's cycle when nothing it reads changed (advance_all)
+        # (route, run-on end) -> the route and run-on, and the relays its open signal's supervision reads
+        self._reads: dict[tuple[str, str | None], tuple[Route, RunOn | None, _Reads]] = {}
 
     # ---- the cycle ----------------------------------------------------------------------------------------------
     def advance_all(self) -> None:
-        il = self.il
-        cycle, changed, in_use = il.cycles, il.tracks_changed, RouteStage.in_use
-        for rs in list(il.routes.values()):
-            memo = rs.release_memo
-            if rs.stage is in_use and memo is not None and self.skip_unchanged and memo.holds(rs, cycle, changed):
-                memo.cycle = cycle  # its release check would change nothing (ReleaseMemo)
-                continue
-            self.advance(rs)
+        """Every route in progress, in order of selection; with ``skip_unchanged``, not those :meth:`unchanged`."""
+        skip = self.skip_unchanged
+        for rs in list(self.il.routes.values()):
+            if not (skip and self.unchanged(rs)):
+                self.advance(rs)
         self._guide_only()
         self._overlaps()
+
+    def unchanged(self, rs: RouteState) -> bool:
+        """The handler of ``rs``'s stage would read only what it read last cycle, unchanged, and so change nothing:
+        a route in use (:class:`ReleaseMemo`), setting (:class:`SettingMemo`) or open (:class:`OpenMemo` and
+        :meth:`_open_unchanged`). When so, its memo is marked as holding through this cycle too."""
+        il = self.il
+        stage, cycle = rs.stage, il.cycles
+        memo: ReleaseMemo | SettingMemo | OpenMemo | None
+        if stage is RouteStage.in_use:
+            memo = rs.release_memo
+            if memo is None or not memo.holds(rs, cycle, il.changes.tracks):
+                return False
+        elif stage is RouteStage.setting:
+            memo = rs.standing_memo
+            if type(memo) is not SettingMemo or not memo.holds(rs, cycle, il.changes.turnouts):
+                return False
+        elif stage is RouteStage.open:
+            memo = rs.standing_memo
+            if type(memo) is not OpenMemo or not memo.holds(rs, cycle, il.changes) \
+                    or not self._open_unchanged(rs, memo):
+                return False
+        else:
+            return False
+        memo.cycle = cycle
+        return True
 
     def advance(self, rs: RouteState) -> None:
         """One cycle of one route: the handler of its stage."""
@@ -88,9 +113,12 @@ class RouteLifecycle:
         il = self.il
         if all(il.board.indication(t.id) == t.position.value for t in rs.all_turnouts):
             rs.stage = RouteStage.locked
+            rs.standing_memo = None
             rs.since = il.now
             il.event("route", f"route {rs.id} locked")
             self._locked(rs)
+        else:
+            rs.standing_memo = SettingMemo(rs, il.cycles)
 
     def _locked(self, rs: RouteState) -> None:
         """Locked, the signal not yet given: it opens as soon as every condition holds."""
@@ -141,11 +169,69 @@ class RouteLifecycle:
         if blocker:
             self.close_signal(rs, blocker, abnormal=True)
             return
-        aspect = il.proven(r.signal, il.wanted_aspect(rs))
+        wanted = il.wanted_aspect(rs)
+        aspect = il.proven(r.signal, wanted)
         before = il.out.signals.get(r.signal)
         if aspect != before:
             il.out.set_aspect(r.signal, aspect)
             il.event("signal", f"signal {r.signal}: {before} -> {aspect}")
+        if aspect == wanted:  # every lamp proven, no alarm raised: looking again on the same finds the same
+            rs.standing_memo = self._open_memo(rs, aspect)
+
+    # ---- what an open signal's supervision read ---------------------------------------------------------------
+    def _open_memo(self, rs: RouteState, aspect: str) -> OpenMemo:
+        il, r = self.il, rs.route
+        sections, signals, doors = self._open_reads(rs)
+        onward = il.route_of(r.end_signal) if r.end_signal else None
+        end_aspect = il.out.signals.get(r.end_signal) if r.end_signal else None
+        return OpenMemo(rs, il.cycles, sections=sections, signals=signals, doors=doors, ledger=il.locks.version,
+                        aspect=aspect, end_aspect=end_aspect, onward=onward, liaison=self._liaison(r),
+                        usu_failed=r.signal in il.usu_failed)
+
+    def _open_unchanged(self, rs: RouteState, memo: OpenMemo) -> bool:
+        """Of the interlocking's own state, what an open signal's supervision reads is as ``memo`` found it."""
+        il, r = self.il, rs.route
+        end = r.end_signal
+        if memo.ledger != il.locks.version or il.out.signals.get(r.signal) != memo.aspect:
+            return False
+        if end is not None:
+            onward = il.route_of(end)
+            if (il.out.signals.get(end) != memo.end_aspect or onward is not memo.onward
+                    or (onward is not None and onward.run_on is not memo.onward_run_on)):
+                return False
+        return (r.signal in il.usu_failed) == memo.usu_failed and self._liaison(r) == memo.liaison
+
+    def _liaison(self, r: Route) -> tuple[object, ...]:
+        """The state of the line a departure leaves by, as the signal's conditions read it (64D, station block,
+        automatic block direction); () for a route that leaves by no line."""
+        il, link = self.il, r.exit_link
+        if link is None:
+            return ()
+        block, station = il.links.get(link), il.station_links.get(link)
+        return (block.state if block else None, station.state if station else None, link in il.line_out)
+
+    def _open_reads(self, rs: RouteState) -> _Reads:
+        """The track relays, signals (lamps, flasher, the next signal's red lamp) and screen-door relays an open
+        signal's supervision reads: the route's own, worked out once per route and run-on."""
+        r = rs.route
+        key = (r.id, rs.run_on.end_node if rs.run_on else None)
+        done = self._reads.get(key)
+        if done is not None and done[0] is r and done[1] is rs.run_on:
+            return done[2]
+        il = self.il
+        secs = {*rs.sections, *r.approach, *(f.section for f in r.fouling), *r.overlap_sections, *r.line_sections}
+        link = r.exit_link
+        if link in il.links:
+            secs.add(il.links[link].departure_section)
+        if link in il.station_links:
+            secs.update(il.station_links[link].sections)
+        if link in il.auto_links:
+            secs.update(il.auto_links[link])
+        signals = {r.signal, *([r.end_signal] if r.end_signal else [])}
+        doors = {k for sec in il.door_sections(r) for k in il.platform_doors.get(sec, ())}
+        reads = (frozenset(secs), frozenset(signals), frozenset(doors))
+        self._reads[key] = (r, rs.run_on, reads)
+        return reads
 
     def _keep_guide(self, rs: RouteState) -> None:
         """The guide aspect closes when the guided train enters the first section inside the signal; when that
@@ -250,6 +336,7 @@ class RouteLifecycle:
         """locked or closed -> open: the signal shows the aspect the route and the signal ahead call for."""
         il, r = self.il, rs.route
         rs.stage = RouteStage.open
+        rs.standing_memo = None
         rs.since = il.now
         aspect = il.proven(r.signal, il.wanted_aspect(rs))
         il.out.set_aspect(r.signal, aspect)

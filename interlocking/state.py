@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from enum import StrEnum
+from typing import Protocol
 
 from .route import Route, RouteTurnout, RunOn
 
@@ -36,6 +37,8 @@ class RouteState:
     guide_approach_seen: bool = False  # under a guide aspect: the guided train has been seen approaching
     # in use: what the last release check saw, so that a cycle in which none of it changed skips it (lifecycle)
     release_memo: ReleaseMemo | None = field(default=None, repr=False, compare=False)
+    # setting or open: what the last look at its turnouts, or at its open signal's conditions, read (lifecycle)
+    standing_memo: SettingMemo | OpenMemo | None = field(default=None, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         n = len(self.sections)
@@ -90,6 +93,71 @@ class ReleaseMemo:
         return (self.cycle == cycle - 1 and self.watched.isdisjoint(changed) and rs.released == self.released
                 and rs.was_occupied == self.was_occupied and rs.overlap_release_at == self.overlap_release_at
                 and rs.run_on is self.run_on and rs.route is self.route)
+
+
+class SettingMemo:
+    """A route setting whose turnouts were not all in position at ``cycle``
+    (:meth:`~.lifecycle.RouteLifecycle._setting` reads nothing but their indications): while none of ``turnouts``
+    changed its indication since, they still are not."""
+
+    __slots__ = ("cycle", "route", "run_on", "turnouts")
+
+    def __init__(self, rs: RouteState, cycle: int) -> None:
+        self.cycle = cycle
+        self.route = rs.route
+        self.run_on = rs.run_on
+        self.turnouts = frozenset(t.id for t in rs.all_turnouts)
+
+    def holds(self, rs: RouteState, cycle: int, turnouts_changed: set[str]) -> bool:
+        return (self.cycle == cycle - 1 and self.turnouts.isdisjoint(turnouts_changed) and rs.route is self.route
+                and rs.run_on is self.run_on)
+
+
+class OpenMemo:
+    """What the supervision of an open signal (:meth:`~.lifecycle.RouteLifecycle._keep_open`) read at ``cycle`` when
+    it found every condition holding and the aspect it wanted proven (no lamp dark, so no alarm raised): the relays
+    of its sections, turnouts, signals and screen doors; the lock ledger's version; the aspects of its own and of the
+    next signal; the route set from the next signal; its line's liaison state; the USU flasher verdict; its own
+    release marks. Looking again on the same of all these finds the same and changes nothing, so while they hold it
+    need not look (``Core.open_blocker`` and ``Core.wanted_aspect`` read nothing else)."""
+
+    __slots__ = ("aspect", "cycle", "doors", "end_aspect", "ledger", "liaison", "onward", "onward_run_on", "route",
+                 "run_on", "sections", "signals", "turnouts", "usu_failed")
+
+    def __init__(self, rs: RouteState, cycle: int, *, sections: frozenset[str], signals: frozenset[str],
+                 doors: frozenset[str], ledger: int, aspect: str | None, end_aspect: str | None,
+                 onward: RouteState | None, liaison: tuple[object, ...], usu_failed: bool) -> None:
+        self.cycle = cycle
+        self.route = rs.route
+        self.run_on = rs.run_on
+        self.turnouts = frozenset(t.id for t in rs.all_turnouts)
+        self.sections = sections
+        self.signals = signals
+        self.doors = doors
+        self.ledger = ledger
+        self.aspect = aspect
+        self.end_aspect = end_aspect
+        self.onward = onward
+        self.onward_run_on = onward.run_on if onward is not None else None
+        self.liaison = liaison
+        self.usu_failed = usu_failed
+
+    def holds(self, rs: RouteState, cycle: int, changes: _Changes) -> bool:
+        """Nothing the supervision reads from the relays changed in ``cycle`` (the one after the memo's) nor, of the
+        interlocking's own state, since: the rest is compared by :meth:`~.lifecycle.RouteLifecycle._open_unchanged`."""
+        return (self.cycle == cycle - 1 and rs.route is self.route and rs.run_on is self.run_on and not rs.entered
+                and not any(rs.released) and self.sections.isdisjoint(changes.tracks)
+                and self.turnouts.isdisjoint(changes.turnouts) and self.signals.isdisjoint(changes.signals)
+                and self.doors.isdisjoint(changes.doors))
+
+
+class _Changes(Protocol):
+    """The relays that changed in a cycle (``core.Changes``)."""
+
+    tracks: set[str]
+    turnouts: set[str]
+    signals: set[str]
+    doors: set[str]
 
 
 @dataclass

@@ -23,6 +23,7 @@ import liansuo.interlocking.derive as derive
 import liansuo.interlocking.lifecycle as lifecycle
 import liansuo.interlocking.locks as locks
 import liansuo.interlocking.operations as operations
+import liansuo.interlocking.state as state
 import liansuo.interlocking.stationblock as stationblock
 from liansuo.interlocking.io import RelayBoard, Result
 from liansuo.interlocking.route import Route
@@ -312,6 +313,24 @@ def _route_ignores_locked_sections(s: ExitStack) -> None:
     _wrap(s, operations.Operator, "route_blocker", blocker)
 
 
+def _open_skip_blind_to_relays(s: ExitStack) -> None:
+    def holds(self: state.OpenMemo, rs: RouteState, cycle: int, changes: Any) -> bool:
+        return self.cycle == cycle - 1 and rs.route is self.route
+    _patch(s, state.OpenMemo, "holds", holds)
+
+
+def _open_skip_blind_to_the_signal_ahead(s: ExitStack) -> None:
+    def unchanged(real: Any) -> Any:
+        def careless(self: Any, rs: RouteState, memo: state.OpenMemo) -> bool:
+            end = rs.route.end_signal
+            if end is None:
+                return real(self, rs, memo)  # type: ignore[no-any-return]
+            with mock.patch.object(memo, "end_aspect", self.il.out.signals.get(end)):
+                return real(self, rs, memo)  # type: ignore[no-any-return]
+        return careless
+    _wrap(s, lifecycle.RouteLifecycle, "_open_unchanged", unchanged)
+
+
 MUTANTS: tuple[Mutant, ...] = (
     Mutant("no-head-on-enemies", "the table leaves out opposing routes onto one track (train against train or "
            "shunting movement)", _no_head_on),
@@ -367,6 +386,10 @@ MUTANTS: tuple[Mutant, ...] = (
            _overlap_released_at_once, first="danxian"),
     Mutant("table-conflicts-skipped", "route setting skips the table's conflicts (only locked sections and "
            "turnouts stop it)", _table_conflicts_skipped),
+    Mutant("open-signal-unwatched", "an open signal is not looked at again while it was fine last cycle, whatever "
+           "relay changed since", _open_skip_blind_to_relays),
+    Mutant("open-signal-blind-ahead", "an open signal keeps its aspect when the signal ahead changes",
+           _open_skip_blind_to_the_signal_ahead),
     Mutant("route-over-locked-sections", "route setting ignores sections other routes hold (an overlap after its "
            "route has released)", _route_ignores_locked_sections, first="danxian"),
 )

@@ -3,16 +3,18 @@
 - a driver's target speed worked out in one pass (``drivers.aim``) against the rule written plainly here, at
   every step of every train, also for the kinds of movement the train is not (shunting, stopping at the boundary),
   and with the way ahead worked out afresh;
-- the release check of a route in use skipped while nothing it reads changed (``ReleaseMemo``): every skip is
-  followed by the check itself, which must then change nothing;
+- a route's cycle skipped while nothing it reads changed (in use: ``ReleaseMemo``, setting: ``SettingMemo``, open:
+  ``OpenMemo``): every skip is followed by the stage's handler itself, which must then change nothing;
 - the odometer worked out only when read (``OdometerFeed``) against one fed step by step.
 
 They run on the hub full of trains of the benchmark and on every bundled example script (shunting, automatic
-shunting, guide aspects, section fault release, faults, SPAD, platform stops)."""
+shunting, guide aspects, section fault release, faults, SPAD, platform stops); the skipped routes also through the
+whole interlocking test of stations with each kind of line liaison."""
 
 from __future__ import annotations
 
 import random
+from collections import Counter
 from dataclasses import dataclass
 from math import sqrt
 from pathlib import Path
@@ -23,8 +25,9 @@ import pytest
 from liansuo.bench.trains import _Dispatcher, train_slots
 from liansuo.cli.main import main
 from liansuo.interlocking.lifecycle import RouteLifecycle
-from liansuo.interlocking.state import RouteStage
+from liansuo.interlocking.state import RouteState
 from liansuo.interlocking.table import build_table
+from liansuo.proving.verify import verify_station
 from liansuo.simulation.sim import Simulation
 from liansuo.simulation.trains import fleet as fleet_module
 from liansuo.simulation.trains.drivers import Lookout
@@ -36,6 +39,7 @@ from liansuo.stations.loader import load_text
 from liansuo.stations.schema import EndKind
 
 EXAMPLES = sorted((Path(__file__).parent.parent / "examples" / "scripts").glob("*.yaml"))
+EXAMPLE_STATIONS = Path(__file__).parent.parent / "examples" / "stations"
 
 
 def _hub_with_trains(cycles: int) -> Simulation:
@@ -137,51 +141,61 @@ def test_the_target_in_one_pass_on_a_hub_full_of_trains(monkeypatch: pytest.Monk
     assert checked.calls > 1500 and checked.bound > 50
 
 
-# ---- the release check skipped while nothing it reads changed ------------------------------------------------------
-class ReleaseChecked:
-    """``RouteLifecycle.advance_all``, followed for every route whose release check it skipped by that check, which
-    must change nothing: no mark, no timer, no event, no route released."""
+# ---- a route's cycle skipped while nothing it reads changed -------------------------------------------------------
+class SkipChecked:
+    """``RouteLifecycle.unchanged`` as ``advance_all`` asks it: every route it skips (in use, setting or open) gets
+    its stage handler run all the same, there and then, which must change nothing: no stage, mark, timer, aspect,
+    lock, alarm or event. The memos are put back as they were, so the run goes on as it would have."""
 
     def __init__(self) -> None:
-        self.skipped = 0
-        self.ran = 0
-        self.real = RouteLifecycle.advance_all
+        self.skipped: Counter[str] = Counter()
+        self.real = RouteLifecycle.unchanged
 
-    def __call__(self, lc: RouteLifecycle) -> None:
-        il = lc.il
-        before = {rid: rs.release_memo for rid, rs in il.routes.items() if rs.stage is RouteStage.in_use}
-        self.real(lc)
-        for rid, memo in before.items():
-            rs = il.routes.get(rid)
-            if rs is None or memo is None or rs.release_memo is not memo or memo.cycle != il.cycles:
-                self.ran += 1
-                continue
-            self.skipped += 1
-            state = self._state(lc, rid)
-            lc._sequential_release(rs)
-            assert self._state(lc, rid) == state, (rid, il.now)
+    def __call__(self, lc: RouteLifecycle, rs: RouteState) -> bool:
+        if not self.real(lc, rs):
+            return False
+        self.skipped[rs.stage.value] += 1
+        memos = rs.release_memo, rs.standing_memo
+        before = self._state(lc, rs)
+        lc.advance(rs)
+        assert self._state(lc, rs) == before, (rs.id, rs.stage, lc.il.now)
+        rs.release_memo, rs.standing_memo = memos
+        return True
 
     @staticmethod
-    def _state(lc: RouteLifecycle, rid: str) -> Any:
+    def _state(lc: RouteLifecycle, rs: RouteState) -> Any:
         il = lc.il
-        rs = il.routes.get(rid)
-        marks = None if rs is None else (list(rs.released), list(rs.was_occupied), rs.overlap_release_at, rs.stage)
-        return marks, len(il.events), il.events[-1] if il.events else None, dict(il.overlap_pending)
+        marks = (rs.stage, rs.entered, list(rs.released), list(rs.was_occupied), rs.overlap_release_at,
+                 rs.release_at, rs.since, il.routes.get(rs.id) is rs)
+        return (marks, dict(il.out.signals), il.locks.version, sorted(il.alarms), len(il.events),
+                il.events[-1] if il.events else None, dict(il.overlap_pending), il.codes_dirty, set(il.usu_failed))
 
 
-def _release_checked(monkeypatch: pytest.MonkeyPatch) -> ReleaseChecked:
-    checked = ReleaseChecked()
-    monkeypatch.setattr(RouteLifecycle, "advance_all", lambda lc: checked(lc))
+def _skip_checked(monkeypatch: pytest.MonkeyPatch) -> SkipChecked:
+    checked = SkipChecked()
+    monkeypatch.setattr(RouteLifecycle, "unchanged", lambda lc, rs: checked(lc, rs))
     return checked
 
 
-def test_release_checks_skipped_on_a_hub_full_of_trains(monkeypatch: pytest.MonkeyPatch) -> None:
-    checked = _release_checked(monkeypatch)
+def test_skipped_routes_on_a_hub_full_of_trains(monkeypatch: pytest.MonkeyPatch) -> None:
+    checked = _skip_checked(monkeypatch)
     _hub_with_trains(1200)
-    assert checked.skipped > 1000 and checked.ran > 20
+    assert checked.skipped["in_use"] > 1000 and checked.skipped["open"] > 100 and checked.skipped["setting"] > 30, \
+        checked.skipped
 
 
-@pytest.mark.parametrize("watch", [_aim_checked, _release_checked], ids=["aim", "release"])
+@pytest.mark.parametrize("station", ["gaotie", "jiaopei", str(EXAMPLE_STATIONS / "danxian.yaml")],
+                         ids=["automatic-block-doors-usu", "64d", "station-block"])
+def test_skipped_routes_through_the_interlocking_test_of_a_station(
+        station: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The whole interlocking test (every fault, release and aspect it tries) on stations with each kind of line
+    liaison, screen doors and USU, each skip followed by its handler."""
+    checked = _skip_checked(monkeypatch)
+    report = verify_station(station)
+    assert report.ok and checked.skipped["open"] > 500 and checked.skipped["setting"] > 500, checked.skipped
+
+
+@pytest.mark.parametrize("watch", [_aim_checked, _skip_checked], ids=["aim", "skip"])
 @pytest.mark.parametrize("script", EXAMPLES, ids=lambda p: p.stem)
 def test_each_shortcut_matches_its_plain_path_in_every_example_script(
         script: Path, watch: Any, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
