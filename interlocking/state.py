@@ -143,8 +143,9 @@ class OpenMemo:
         self.usu_failed = usu_failed
 
     def holds(self, rs: RouteState, cycle: int, changes: _Changes) -> bool:
-        """Nothing the supervision reads from the relays changed in ``cycle`` (the one after the memo's) nor, of the
-        interlocking's own state, since: the rest is compared by :meth:`~.lifecycle.RouteLifecycle._open_unchanged`."""
+        """None of the relays the supervision reads changed in ``cycle`` (the cycle after the memo's), the route and
+        its run-on are the same, nothing entered it and nothing of it released. The interlocking's own state (locks,
+        aspects, the onward route, the line) is compared by :meth:`~.lifecycle.RouteLifecycle._open_unchanged`."""
         return (self.cycle == cycle - 1 and rs.route is self.route and rs.run_on is self.run_on and not rs.entered
                 and not any(rs.released) and self.sections.isdisjoint(changes.tracks)
                 and self.turnouts.isdisjoint(changes.turnouts) and self.signals.isdisjoint(changes.signals)
