@@ -53,47 +53,57 @@ class LockLedger:
         self.turnouts: dict[str, set[Lock]] = {}
         self.blocked: set[str] = set()  # 单封: no route over the turnout (not a lock: individual operation stays)
         self.version = 0  # counts changes, so a reader can tell when nothing changed
+        # each lock -> the sections and turnouts it is on, so that giving a holder's locks back looks only at those
+        self._on: dict[Lock, tuple[set[str], set[str]]] = {}
 
     # ---- taking and giving back -----------------------------------------------------------------------------------
     def lock_section(self, section: str, hold: Hold, holder: str = "") -> None:
-        self.version += 1
-        self.sections.setdefault(section, set()).add(Lock(hold, holder))
+        self._take(self.sections, 0, section, Lock(hold, holder))
 
     def unlock_section(self, section: str, hold: Hold, holder: str = "") -> None:
-        self.version += 1
-        locks = self.sections.get(section)
-        if locks is not None:
-            locks.discard(Lock(hold, holder))
-            if not locks:
-                del self.sections[section]
+        self._give(self.sections, 0, section, Lock(hold, holder))
 
     def lock_turnout(self, turnout: str, hold: Hold, holder: str = "") -> None:
-        self.version += 1
-        self.turnouts.setdefault(turnout, set()).add(Lock(hold, holder))
+        self._take(self.turnouts, 1, turnout, Lock(hold, holder))
 
     def unlock_turnout(self, turnout: str, hold: Hold, holder: str = "") -> None:
-        self.version += 1
-        locks = self.turnouts.get(turnout)
-        if locks is not None:
-            locks.discard(Lock(hold, holder))
-            if not locks:
-                del self.turnouts[turnout]
+        self._give(self.turnouts, 1, turnout, Lock(hold, holder))
 
     def release(self, hold: Hold, holder: str = "") -> None:
         """Give back every lock ``holder`` holds as ``hold``."""
-        self.version += 1
-        lock = Lock(hold, holder)
-        for table in (self.sections, self.turnouts):
-            for key in [k for k, locks in table.items() if lock in locks]:
-                table[key].discard(lock)
-                if not table[key]:
-                    del table[key]
+        self._release(Lock(hold, holder))
 
     def release_all(self, hold: Hold) -> None:
         self.version += 1
-        for table in (self.sections, self.turnouts):
-            for key in list(table):
-                table[key] = {lk for lk in table[key] if lk.hold is not hold}
+        for lock in [lk for lk in self._on if lk.hold is hold]:
+            self._release(lock)
+
+    def _take(self, table: dict[str, set[Lock]], kind: int, key: str, lock: Lock) -> None:
+        self.version += 1
+        table.setdefault(key, set()).add(lock)
+        self._on.setdefault(lock, (set(), set()))[kind].add(key)
+
+    def _give(self, table: dict[str, set[Lock]], kind: int, key: str, lock: Lock) -> None:
+        self.version += 1
+        locks = table.get(key)
+        if locks is not None:
+            locks.discard(lock)
+            if not locks:
+                del table[key]
+        on = self._on.get(lock)
+        if on is not None:
+            on[kind].discard(key)
+            if not on[0] and not on[1]:
+                del self._on[lock]
+
+    def _release(self, lock: Lock) -> None:
+        self.version += 1
+        on = self._on.pop(lock, None)
+        if on is None:
+            return
+        for table, keys in zip((self.sections, self.turnouts), on, strict=True):
+            for key in keys:
+                table[key].discard(lock)
                 if not table[key]:
                     del table[key]
 
