@@ -108,8 +108,10 @@ class LockLedger:
                     del table[key]
 
     # ---- questions ----------------------------------------------------------------------------------------------
-    def section_locks(self, section: str) -> set[Lock]:
-        return self.sections.get(section, set())
+    def section_locks(self, section: str) -> list[Lock]:
+        """The locks on ``section`` in a fixed order (by kind, then holder), so that what is said of the first is the
+        same in every process (a set's order follows the string hashing of its process)."""
+        return sorted(self.sections.get(section, ()), key=_order)
 
     def section_locked(self, section: str) -> bool:
         return section in self.sections

@@ -75,3 +75,17 @@ def test_a_route_released_leaves_the_others_locks() -> None:
     ledger.release(Hold.overlap, "X-XI")
     ledger.release(Hold.route, "S-SII")
     assert ledger.sections == {} and ledger.turnouts == {}
+
+
+def test_a_sections_locks_come_in_the_same_order_however_they_were_taken() -> None:
+    """What a refusal names first (the first lock) does not follow the order of taking, nor the process's hashing."""
+    taken = [(Hold.overlap, "X-XI"), (Hold.route, "S-SII"), (Hold.fouling, "D1-D3"), (Hold.route, "D5-D7")]
+    seen = []
+    for order in (taken, taken[::-1], taken[1:] + taken[:1]):
+        ledger = LockLedger({})
+        for hold, holder in order:
+            ledger.lock_section("1DG", hold, holder)
+        seen.append(ledger.section_locks("1DG"))
+    assert seen[0] == seen[1] == seen[2]
+    assert [(lk.hold, lk.holder) for lk in seen[0]] == [(Hold.route, "D5-D7"), (Hold.route, "S-SII"),
+                                                        (Hold.overlap, "X-XI"), (Hold.fouling, "D1-D3")]
