@@ -22,7 +22,7 @@ from .aspects import is_open, stop_aspect
 from .core import Core
 from .locks import Hold
 from .route import Route, RunOn
-from .state import GuideOnly, OpenMemo, ReleaseMemo, RouteStage, RouteState, SettingMemo
+from .state import GuideOnly, OpenMemo, Reads, ReleaseMemo, RouteStage, RouteState, SettingMemo
 
 HANDLERS = {  # the method that runs a route in each stage, one cycle
     RouteStage.setting: "_setting",
@@ -33,7 +33,6 @@ HANDLERS = {  # the method that runs a route in each stage, one cycle
     RouteStage.in_use: "_sequential_release",
     RouteStage.time_release: "_time_release",
 }
-_Reads = tuple[frozenset[str], frozenset[str], frozenset[str]]  # sections, signals, screen doors
 # stages in which the signal has been opened: a train approaching makes the route approach-locked (接近锁闭)
 SIGNAL_GIVEN = frozenset({RouteStage.open, RouteStage.guide, RouteStage.closed, RouteStage.time_release})
 
@@ -44,8 +43,7 @@ class RouteLifecycle:
     def __init__(self, core: Core) -> None:
         self.il = core
         self.skip_unchanged = True  # skip a route's cycle when nothing it reads changed (advance_all)
-        # (route, run-on end) -> the route and run-on, and the relays its open signal's supervision reads
-        self._reads: dict[tuple[str, str | None], tuple[Route, RunOn | None, _Reads]] = {}
+        self._reads: dict[str, tuple[RunOn | None, Reads]] = {}  # route id -> its run-on and what it reads (reads)
 
     # ---- the cycle ----------------------------------------------------------------------------------------------
     def advance_all(self) -> None:
@@ -118,7 +116,7 @@ class RouteLifecycle:
             il.event("route", f"route {rs.id} locked")
             self._locked(rs)
         else:
-            rs.standing_memo = SettingMemo(rs, il.cycles)
+            rs.standing_memo = SettingMemo(rs, il.cycles, self.reads(rs))
 
     def _locked(self, rs: RouteState) -> None:
         """Locked, the signal not yet given: it opens as soon as every condition holds."""
@@ -181,12 +179,10 @@ class RouteLifecycle:
     # ---- what an open signal's supervision read ---------------------------------------------------------------
     def _open_memo(self, rs: RouteState, aspect: str) -> OpenMemo:
         il, r = self.il, rs.route
-        sections, signals, doors = self._open_reads(rs)
         onward = il.route_of(r.end_signal) if r.end_signal else None
         end_aspect = il.out.signals.get(r.end_signal) if r.end_signal else None
-        return OpenMemo(rs, il.cycles, sections=sections, signals=signals, doors=doors, ledger=il.locks.version,
-                        aspect=aspect, end_aspect=end_aspect, onward=onward, liaison=self._liaison(r),
-                        usu_failed=r.signal in il.usu_failed)
+        return OpenMemo(rs, il.cycles, self.reads(rs), ledger=il.locks.version, aspect=aspect, end_aspect=end_aspect,
+                        onward=onward, liaison=self._liaison(r), usu_failed=r.signal in il.usu_failed)
 
     def _open_unchanged(self, rs: RouteState, memo: OpenMemo) -> bool:
         """Of the interlocking's own state, what an open signal's supervision reads is as ``memo`` found it."""
@@ -210,14 +206,12 @@ class RouteLifecycle:
         block, station = il.links.get(link), il.station_links.get(link)
         return (block.state if block else None, station.state if station else None, link in il.line_out)
 
-    def _open_reads(self, rs: RouteState) -> _Reads:
-        """The track relays, signals (lamps, flasher, the next signal's red lamp) and screen-door relays an open
-        signal's supervision reads: the route's own, worked out once per route and run-on."""
+    def reads(self, rs: RouteState) -> Reads:
+        """The relays a route's supervision reads (:class:`Reads`), worked out once per route and run-on."""
         r = rs.route
-        key = (r.id, rs.run_on.end_node if rs.run_on else None)
-        done = self._reads.get(key)
-        if done is not None and done[0] is r and done[1] is rs.run_on:
-            return done[2]
+        done = self._reads.get(r.id)
+        if done is not None and done[0] is rs.run_on:
+            return done[1]
         il = self.il
         secs = {*rs.sections, *r.approach, *(f.section for f in r.fouling), *r.overlap_sections, *r.line_sections}
         link = r.exit_link
@@ -227,10 +221,10 @@ class RouteLifecycle:
             secs.update(il.station_links[link].sections)
         if link in il.auto_links:
             secs.update(il.auto_links[link])
-        signals = {r.signal, *([r.end_signal] if r.end_signal else [])}
-        doors = {k for sec in il.door_sections(r) for k in il.platform_doors.get(sec, ())}
-        reads = (frozenset(secs), frozenset(signals), frozenset(doors))
-        self._reads[key] = (r, rs.run_on, reads)
+        reads = Reads(sections=frozenset(secs), turnouts=frozenset(t.id for t in rs.all_turnouts),
+                      signals=frozenset({r.signal, *([r.end_signal] if r.end_signal else [])}),
+                      doors=frozenset(k for sec in il.door_sections(r) for k in il.platform_doors.get(sec, ())))
+        self._reads[r.id] = (rs.run_on, reads)
         return reads
 
     def _keep_guide(self, rs: RouteState) -> None:

@@ -95,6 +95,18 @@ class ReleaseMemo:
                 and rs.run_on is self.run_on and rs.route is self.route)
 
 
+@dataclass(frozen=True)
+class Reads:
+    """What a route's supervision reads of the relays, by name: its sections (with approach, fouling, overlap, line
+    and liaison sections), its turnouts (with the overlap's), its own and the next signal, its screen doors. The same
+    for a route and run-on whenever it is set, so worked out once (``RouteLifecycle.reads``)."""
+
+    sections: frozenset[str]
+    turnouts: frozenset[str]
+    signals: frozenset[str]
+    doors: frozenset[str]
+
+
 class SettingMemo:
     """A route setting whose turnouts were not all in position at ``cycle``
     (:meth:`~.lifecycle.RouteLifecycle._setting` reads nothing but their indications): while none of ``turnouts``
@@ -102,11 +114,11 @@ class SettingMemo:
 
     __slots__ = ("cycle", "route", "run_on", "turnouts")
 
-    def __init__(self, rs: RouteState, cycle: int) -> None:
+    def __init__(self, rs: RouteState, cycle: int, reads: Reads) -> None:
         self.cycle = cycle
         self.route = rs.route
         self.run_on = rs.run_on
-        self.turnouts = frozenset(t.id for t in rs.all_turnouts)
+        self.turnouts = reads.turnouts
 
     def holds(self, rs: RouteState, cycle: int, turnouts_changed: set[str]) -> bool:
         return (self.cycle == cycle - 1 and self.turnouts.isdisjoint(turnouts_changed) and rs.route is self.route
@@ -121,19 +133,16 @@ class OpenMemo:
     release marks. Looking again on the same of all these finds the same and changes nothing, so while they hold it
     need not look (``Core.open_blocker`` and ``Core.wanted_aspect`` read nothing else)."""
 
-    __slots__ = ("aspect", "cycle", "doors", "end_aspect", "ledger", "liaison", "onward", "onward_run_on", "route",
-                 "run_on", "sections", "signals", "turnouts", "usu_failed")
+    __slots__ = ("aspect", "cycle", "end_aspect", "ledger", "liaison", "onward", "onward_run_on", "reads", "route",
+                 "run_on", "usu_failed")
 
-    def __init__(self, rs: RouteState, cycle: int, *, sections: frozenset[str], signals: frozenset[str],
-                 doors: frozenset[str], ledger: int, aspect: str | None, end_aspect: str | None,
-                 onward: RouteState | None, liaison: tuple[object, ...], usu_failed: bool) -> None:
+    def __init__(self, rs: RouteState, cycle: int, reads: Reads, *, ledger: int, aspect: str | None,
+                 end_aspect: str | None, onward: RouteState | None, liaison: tuple[object, ...],
+                 usu_failed: bool) -> None:
         self.cycle = cycle
         self.route = rs.route
         self.run_on = rs.run_on
-        self.turnouts = frozenset(t.id for t in rs.all_turnouts)
-        self.sections = sections
-        self.signals = signals
-        self.doors = doors
+        self.reads = reads
         self.ledger = ledger
         self.aspect = aspect
         self.end_aspect = end_aspect
@@ -146,10 +155,11 @@ class OpenMemo:
         """None of the relays the supervision reads changed in ``cycle`` (the cycle after the memo's), the route and
         its run-on are the same, nothing entered it and nothing of it released. The interlocking's own state (locks,
         aspects, the onward route, the line) is compared by :meth:`~.lifecycle.RouteLifecycle._open_unchanged`."""
+        reads = self.reads
         return (self.cycle == cycle - 1 and rs.route is self.route and rs.run_on is self.run_on and not rs.entered
-                and not any(rs.released) and self.sections.isdisjoint(changes.tracks)
-                and self.turnouts.isdisjoint(changes.turnouts) and self.signals.isdisjoint(changes.signals)
-                and self.doors.isdisjoint(changes.doors))
+                and not any(rs.released) and reads.sections.isdisjoint(changes.tracks)
+                and reads.turnouts.isdisjoint(changes.turnouts) and reads.signals.isdisjoint(changes.signals)
+                and reads.doors.isdisjoint(changes.doors))
 
 
 class _Changes(Protocol):
