@@ -75,3 +75,47 @@ def test_make_run_shows_the_station_and_ctrl_q_asks_then_quits(tmp_path: Path) -
         assert "Traceback" not in screen
     finally:
         _tmux("kill-session", "-t", session)
+
+
+def _children(pid: int) -> list[int]:
+    out = subprocess.run(["ps", "-o", "pid=", "--ppid", str(pid)], capture_output=True, text=True, check=False)
+    return [int(x) for x in out.stdout.split()]
+
+
+def _alive(pid: int) -> bool:
+    state = subprocess.run(["ps", "-o", "stat=", "-p", str(pid)], capture_output=True, text=True, check=False)
+    return bool(state.stdout.strip()) and not state.stdout.strip().startswith("Z")
+
+
+def test_closing_the_terminal_of_make_run_ends_the_console() -> None:
+    """A terminal window closed under `make run`: make gets the hangup, the console does not (it is make's child),
+    and must still end, not read a dead terminal forever with a core busy. On a private tmux server."""
+    server, session = f"liansuo-hup-{uuid.uuid4().hex[:8]}", "console"
+    tmux = ["tmux", "-L", server]
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("TMUX", "TEXTUAL"))}
+    env["TERM"] = "xterm-256color"
+    subprocess.run([*tmux, "new-session", "-d", "-s", session, "-x", "80", "-y", "24",
+                    f"cd {shlex.quote(str(ROOT))} && exec {_make_command(ROOT)}"], check=True, env=env)
+    consoles: list[int] = []
+    try:
+        deadline = time.monotonic() + 60.0
+        screen = ""
+        while time.monotonic() < deadline and "总取消" not in screen:
+            screen = subprocess.run([*tmux, "capture-pane", "-t", session, "-p"], capture_output=True, text=True,
+                                    check=False).stdout
+            time.sleep(0.2)
+        assert "总取消" in screen, screen
+        make = int(subprocess.run([*tmux, "list-panes", "-t", session, "-F", "#{pane_pid}"], capture_output=True,
+                                  text=True, check=True).stdout.split()[0])
+        consoles = [pid for child in _children(make) for pid in [child, *_children(child)]]
+        assert consoles, "no console process under make"
+        subprocess.run([*tmux, "kill-server"], check=False)  # the terminal goes away
+        deadline = time.monotonic() + 10.0
+        while time.monotonic() < deadline and any(_alive(pid) for pid in consoles):
+            time.sleep(0.2)
+        assert not any(_alive(pid) for pid in consoles), "the console outlived its terminal"
+    finally:
+        subprocess.run([*tmux, "kill-server"], check=False)
+        for pid in consoles:
+            if _alive(pid):
+                os.kill(pid, 9)

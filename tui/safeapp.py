@@ -6,9 +6,15 @@
 - A dialog answered twice in one burst of input cannot close the console's own screen; the command palette
   (:mod:`tui.palette`) is closed as safely.
 - Every way out asks first: ctrl+q, the command palette's Quit, ``quit`` in the command bar.
+- A terminal that goes away ends the console. Closing a terminal window hangs up its terminal; a console started
+  under ``make run`` gets no hangup signal (make does), and would go on reading a dead terminal forever, a core busy.
+  So the console looks every second whether its terminal is still there, and ends without asking when it is not.
 """
 
 from __future__ import annotations
+
+import os
+import sys
 
 from textual.app import App
 from textual.await_complete import AwaitComplete
@@ -26,10 +32,34 @@ class ConsoleScreen(Guarded, Screen[None]):
     """The console's main screen: an error in its handlers is reported, not fatal."""
 
 
+HANGUP_CHECK_S = 1.0  # how often a console in a terminal looks whether its terminal is still there
+
+
 class SafeApp(Guarded, App[None]):
     def __init__(self) -> None:
         super().__init__()
         self.incidents = Incidents()
+
+    def on_mount(self) -> None:
+        fd = self._terminal()
+        if fd is not None:
+            self.set_interval(HANGUP_CHECK_S, lambda: self._terminal_gone(fd))
+
+    def _terminal(self) -> int | None:
+        """The console's terminal, when it runs in one (not served to a browser, not under test)."""
+        if self.is_web or self.is_headless:
+            return None
+        for stream in (sys.__stdin__, sys.__stdout__):
+            try:
+                if stream is not None and os.isatty(stream.fileno()):
+                    return stream.fileno()
+            except (OSError, ValueError):
+                continue
+        return None
+
+    def _terminal_gone(self, fd: int) -> None:
+        if not os.isatty(fd):  # hung up: nobody can read the console or answer it any more
+            self.exit()
 
     # ---- what the console fills in ----
     def sim_time(self) -> float | None:
