@@ -17,6 +17,7 @@ from .io import Alarm, Event, Outputs, RelayBoard
 from .lifecycle import RouteLifecycle
 from .locks import LockLedger
 from .operations import Operator
+from .quiet import Mark, Quiet, quiet_after
 from .route import InterlockingTable
 from .state import RouteState
 
@@ -26,20 +27,37 @@ class Interlocking:
     console's commands (``il.operator.set_route(...)``). ``locked_at_start``: after power-up (上电), every section
     locked until the power-up release."""
 
+    skip_quiet = True  # run no cycle while the interlocking is at rest (quiet.py); tests switch it off
+
     def __init__(self, table: InterlockingTable, rules: RuleSet | None = None, cycle_s: float = 0.25, *,
                  locked_at_start: bool = False) -> None:
         self.core = Core(table, rules, cycle_s, locked_at_start=locked_at_start)
         self.lifecycle = RouteLifecycle(self.core)
-        self.operator = Operator(self.core, self.lifecycle)
+        self._operator = Operator(self.core, self.lifecycle)
+        self.quiet: Quiet | None = None  # at rest after the last cycle: until when (quiet.py)
+
+    @property
+    def operator(self) -> Operator:
+        """The console's commands. Reaching for them ends a rest (:mod:`.quiet`): a command may change anything."""
+        self.quiet = None
+        return self._operator
 
     def cycle(self, t: float) -> Outputs:
         core = self.core
+        quiet = self.quiet
+        if quiet is not None and self.skip_quiet and not core.board.pending() and quiet.holds(t):
+            core.now = t
+            core.cycles += 1
+            return core.out
+        before = Mark.of(core)
         changes = core.take_inputs(t)
         if changes.tracks:
             self.lifecycle.check_spad(changes.tracks)
         core.apply_inputs(changes)
-        self.lifecycle.advance_all()
-        return core.give_outputs(changes)
+        settled = self.lifecycle.advance_all()
+        out = core.give_outputs(changes)
+        self.quiet = quiet_after(core, before, changes, settled)
+        return out
 
     # ---- what the world reads of the interlocking's state ------------------------------------------------------
     @property

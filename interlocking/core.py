@@ -106,6 +106,7 @@ class Core:
         self.usu_failed: set[str] = set()  # flasher check failed while showing USU: UU until the route releases
         self.guide_only: dict[str, GuideOnly] = {}  # guide aspect without a route (throat under guide total lock)
         self.events: deque[Event] = deque(maxlen=MAX_EVENTS)
+        self.logged = 0  # events logged so far (the deque keeps the last MAX_EVENTS)
         self.alarms: dict[str, Alarm] = {}
         self.entry_section = index.entry_section
         self.signal_by_entry = index.signal_by_entry
@@ -126,6 +127,7 @@ class Core:
     # ---- bookkeeping --------------------------------------------------------------------------------------------
     def event(self, kind: str, text: str) -> None:
         self.events.append(Event(self.now, kind, text))
+        self.logged += 1
 
     def alarm(self, kind: str, element: str, text: str, *, detail: str = "") -> None:
         """Raise an alarm of ``kind`` (closed, lamp, red, filament, flasher, move, squeeze, spad) on a signal or

@@ -106,6 +106,11 @@ class RelayBoard:
     def doors_safe(self, key: str) -> bool:
         return self.pdkj.get(key, False) or self.pdqcj.get(key, False)
 
+    def pending(self) -> bool:
+        """A relay changed, or a line pulse came, since the interlocking last took the changes."""
+        return bool(self.changed_tracks or self.changed_turnouts or self.changed_signals or self.changed_doors
+                    or self.line_in)
+
     def take_changes(self) -> tuple[set[str], set[str], set[str], set[str], dict[str, set[str]]]:
         out = (self.changed_tracks, self.changed_turnouts, self.changed_signals, self.changed_doors, self.line_in)
         self.changed_tracks, self.changed_turnouts, self.changed_signals = set(), set(), set()

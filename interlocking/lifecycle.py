@@ -46,14 +46,26 @@ class RouteLifecycle:
         self._reads: dict[str, tuple[RunOn | None, Reads]] = {}  # route id -> its run-on and what it reads (reads)
 
     # ---- the cycle ----------------------------------------------------------------------------------------------
-    def advance_all(self) -> None:
-        """Every route in progress, in order of selection; with ``skip_unchanged``, not those :meth:`unchanged`."""
+    def advance_all(self) -> bool:
+        """Every route in progress, in order of selection; with ``skip_unchanged``, not those :meth:`unchanged`.
+        True when no route changed: each was skipped, or its handler left it as it was and reads no clock (a guide
+        aspect closes by itself after a time: :mod:`.quiet` counts only the timers it knows)."""
         skip = self.skip_unchanged
-        for rs in list(self.il.routes.values()):
-            if not (skip and self.unchanged(rs)):
+        settled = True
+        routes = self.il.routes
+        for rs in list(routes.values()):
+            if skip and self.unchanged(rs):
+                continue
+            if not settled or rs.stage is RouteStage.guide:
                 self.advance(rs)
+                settled = False
+                continue
+            before = _look(rs)
+            self.advance(rs)
+            settled = routes.get(rs.id) is rs and _look(rs) == before
         self._guide_only()
         self._overlaps()
+        return settled
 
     def unchanged(self, rs: RouteState) -> bool:
         """The handler of ``rs``'s stage would read only what it read last cycle, unchanged, and so change nothing:
@@ -483,3 +495,9 @@ class RouteLifecycle:
     def approach_locked(self, rs: RouteState) -> bool:
         """接近锁闭: the signal has been given and a train is in the approach section."""
         return rs.stage in SIGNAL_GIVEN and any(not self.il.clear(s) for s in rs.route.approach)
+
+
+def _look(rs: RouteState) -> tuple[object, ...]:
+    """What a route's handler may change on the route itself (the rest it changes shows in :class:`~.quiet.Mark`)."""
+    return (rs.stage, rs.since, rs.entered, rs.release_at, rs.overlap_release_at, rs.guide_first_clear,
+            rs.guide_approach_seen, tuple(rs.released), tuple(rs.was_occupied), rs.run_on)

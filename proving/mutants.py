@@ -331,6 +331,10 @@ def _open_skip_blind_to_the_signal_ahead(s: ExitStack) -> None:
     _wrap(s, lifecycle.RouteLifecycle, "_open_unchanged", unchanged)
 
 
+def _rest_deaf_to_relays(s: ExitStack) -> None:
+    _patch(s, RelayBoard, "pending", lambda self: False)
+
+
 MUTANTS: tuple[Mutant, ...] = (
     Mutant("no-head-on-enemies", "the table leaves out opposing routes onto one track (train against train or "
            "shunting movement)", _no_head_on),
@@ -390,6 +394,8 @@ MUTANTS: tuple[Mutant, ...] = (
            "relay changed since", _open_skip_blind_to_relays),
     Mutant("open-signal-blind-ahead", "an open signal keeps its aspect when the signal ahead changes",
            _open_skip_blind_to_the_signal_ahead),
+    Mutant("rest-deaf-to-relays", "the interlocking at rest sleeps on through relay changes, until a command or "
+           "a timer wakes it", _rest_deaf_to_relays),
     Mutant("route-over-locked-sections", "route setting ignores sections other routes hold (an overlap after its "
            "route has released)", _route_ignores_locked_sections, first="danxian"),
 )

@@ -1,0 +1,87 @@
+"""The interlocking at rest: a cycle that changed nothing is followed by cycles that change nothing, until a relay
+changes, the operator gives a command, or a timer runs out.
+
+A cycle is a function of the interlocking's state, its relay inputs and the time. When one cycle changed nothing
+(no relay changed before it, every route's cycle was skipped by its memo or waited without a change, the turnouts,
+lines, alarms, events, locks and outputs stayed as they were), the next cycle starts from the same state with the
+same relays, so it changes nothing either, unless one of the time conditions read in a cycle turns: a turnout's
+move time-out, the squeeze alarm of a turnout without indication, a time release, an overlap's release time. A
+:class:`Quiet` keeps those conditions, worked out with the very expressions the cycle uses, and
+:meth:`~.cbi.Interlocking.cycle` runs no cycle while it holds (it only moves the clock and the cycle count).
+
+tests/test_quiet_same.py runs the real cycle in place of every quiet one and compares the whole state (pickled, not
+read through this module) before and after it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+from .state import RouteStage
+
+if TYPE_CHECKING:
+    from .core import Changes, Core
+
+
+@dataclass(frozen=True)
+class Mark:
+    """What a cycle may change, counted before it: compared after it (:func:`quiet_after`)."""
+
+    logged: int
+    alarms: int
+    locks: int
+    moving: int
+    queued: int
+    lines: tuple[str, ...]
+    dirty: bool
+
+    @staticmethod
+    def of(core: Core) -> Mark:
+        return Mark(core.logged, len(core.alarms), core.locks.version, len(core.moving), len(core.queue),
+                    tuple(sl.state.value for sl in core.station_links.values()),
+                    core.codes_dirty or (core.blocks_dirty and bool(core.autoblock.signals)))
+
+
+@dataclass(frozen=True)
+class Quiet:
+    """The time conditions that would make the next cycle act (each as the cycle writes it, negated)."""
+
+    moves: tuple[float, ...]  # move_started of the turnouts being driven: time-out once now - it > timeout_s
+    timeout_s: float
+    squeezes: tuple[float, ...]  # since when turnouts without indication have none: squeeze alarm once now - it >= s
+    squeeze_s: float
+    due: tuple[float, ...]  # time releases and overlap releases: once now >= it
+
+    def holds(self, now: float) -> bool:
+        """A cycle at ``now`` would change nothing (with no relay changed and no command since the last cycle)."""
+        return (all(not now - s > self.timeout_s for s in self.moves)
+                and all(not now - s >= self.squeeze_s for s in self.squeezes)
+                and all(not now >= at for at in self.due))
+
+
+def quiet_after(core: Core, before: Mark, changes: Changes, routes_settled: bool) -> Quiet | None:
+    """The :class:`Quiet` of the cycle just run, if it changed nothing; None if it changed something or may act
+    again on its own (a guide aspect without a route, a move waiting in the queue while fewer than the allowed
+    moves run)."""
+    if (changes.tracks or changes.turnouts or changes.signals or changes.doors or changes.pulses
+            or changes.commanded or not routes_settled):
+        return None
+    out = core.out
+    if out.changed_signals or out.changed_turnouts or out.line_out or out.axle_resets or core.guide_only:
+        return None
+    if Mark.of(core) != before or before.dirty:
+        return None
+    if core.queue and len(core.moving) < core.rules.turnout_concurrency:
+        return None
+    turnouts = core.turnouts
+    moves = tuple(ts.move_started for t in core.moving if (ts := turnouts[t]).move_started is not None)
+    squeezes = []
+    for t in core.no_indication:
+        ts = turnouts[t]
+        if not (t in core.moving or ts.queued or ts.squeeze_alarmed or not ts.trailable):
+            squeezes.append(ts.no_indication_since if ts.no_indication_since is not None else 0.0)
+    due = [at for at in core.overlap_pending.values() if at is not None]
+    due += [rs.release_at for rs in core.routes.values()
+            if rs.stage is RouteStage.time_release and rs.release_at is not None]
+    return Quiet(moves, core.rules.turnout_timeout_s, tuple(squeezes), core.rules.squeeze_alarm_s, tuple(due))
