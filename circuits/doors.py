@@ -43,6 +43,14 @@ class PlatformDoors:
     def is_open(self) -> bool:
         return self.opening > 0.0 or self.faults.stuck
 
+    def still_under(self, zckj: bool, kmj: bool, gmj: bool) -> bool:
+        """Standing still, and :meth:`command` with these relays would not set it moving."""
+        if self.moving:
+            return False
+        opens = kmj and zckj and not self.faults.no_open and not gmj
+        closes = gmj and not self.faults.no_close and self.opening > 0.0
+        return not (opens or closes)
+
     def command(self, zckj: bool, kmj: bool, gmj: bool) -> None:
         authorised = zckj and not self.faults.no_open
         if kmj and authorised and not gmj:

@@ -242,6 +242,40 @@ class Field:
         for sec in self.flicker.since:
             self._flick(sec)
 
+    def rest_steps(self, dt: float, commands: FieldCommands, limit: int) -> int:
+        """How many of the next steps (at most ``limit``) would do nothing but run on the switch machines already
+        running towards their positions: no relay changes (none is waiting to be taken either), no lamp, flasher,
+        door, axle counter or leakage to work on, no drive command to act on, and no move ends. 0 when the next
+        step does more than that."""
+        ch = self._changes
+        if ch.tracks or ch.turnouts or ch.signals or ch.doors or commands.changed_signals or commands.axle_resets \
+                or self.flicker.since or any(fl.energised for fl in self.flashers.values()):
+            return 0
+        doors = commands.doors
+        for key, d in self.doors.items():
+            if d.moving or (key in doors and not d.still_under(*doors[key])):
+                return 0
+        drives = commands.drives
+        if self._driven != drives.keys():
+            return 0
+        for t_id, target in drives.items():
+            m = self.machines[t_id]
+            if (target != m.target or not m.running) and m.drive_changes(target):
+                return 0
+        n = limit
+        for t_id in self._moving:
+            left = self.machines[t_id].steps_left(dt)
+            if left is not None:
+                n = min(n, left - 1)
+        return max(n, 0)
+
+    def rest(self, dt: float, n: int) -> None:
+        """``n`` steps of ``dt`` allowed by :meth:`rest_steps`: the running machines' progress and the clock."""
+        for t_id in self._moving:
+            self.machines[t_id].coast(dt, n)
+        for _ in range(n):
+            self.t += dt
+
     def _relight(self, signal: str, lit: set[str]) -> None:
         before = self.lamps[signal].proving()
         self.lamps[signal].apply(lit)

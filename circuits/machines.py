@@ -93,6 +93,33 @@ class SwitchMachine:
         self.progress = 0.0
         self.rails = None if self.rails != target else self.rails
 
+    def drive_changes(self, target: str | None) -> bool:
+        """Would :meth:`drive` with ``target`` change anything?"""
+        if target is None:
+            return self.running or self.target is not None
+        if target == self.target and self.running:
+            return False
+        return not (target == self.rails and self.locked and self.target is None)
+
+    def steps_left(self, dt: float) -> int | None:
+        """How many steps of ``dt`` until the one that ends the move, counted as :meth:`step` adds them up (the same
+        float sums); None when no step ends it (the motor is not running, or its clutch slips)."""
+        if not self.running or self.target is None or self.clutch_slips:
+            return None
+        progress, n = self.progress, 0
+        while True:
+            progress += dt
+            n += 1
+            if not progress + 1e-9 < self.spec.throw_s:
+                return n
+
+    def coast(self, dt: float, n: int) -> None:
+        """``n`` steps that do not end the move (fewer than :meth:`steps_left`): only the progress runs on."""
+        if not self.running or self.target is None or self.clutch_slips:
+            return
+        for _ in range(n):
+            self.progress += dt
+
     def step(self, dt: float) -> bool:
         """Advance the motor; True when the indication may have changed."""
         if not self.running or self.target is None:

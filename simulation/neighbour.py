@@ -123,6 +123,23 @@ class Neighbours:
                 nb.our_train_out = False
                 nb.outbox.append((t + self.pulse_s, "restore"))
 
+    def rests(self, line_out: dict[str, set[str]], clear: Callable[[str], bool]) -> bool:
+        """A step with these pulses sent out (and none of the neighbours' falling due: :meth:`next_due`) would change
+        nothing but the clock."""
+        if line_out:
+            return False
+        for link, sn in self.station_lines.items():
+            line_clear = all(clear(s) for s in self.line_sections[link])
+            if ((sn.ours or sn.its) and not line_clear and not sn.seen_occupied) or \
+                    (sn.ours and sn.seen_occupied and line_clear):
+                return False
+        return not any(nb.our_train_out and nb.auto and clear(self.section[link]) for link, nb in self.by_link.items())
+
+    def next_due(self) -> float | None:
+        """When the first pulse waiting to be sent falls due (None: none waits)."""
+        times = [at for at, _, _ in self.outbox] + [at for nb in self.by_link.values() for at, _ in nb.outbox]
+        return min(times) if times else None
+
     def publish(self, board: RelayBoard) -> None:
         sent = [(link, p) for at, link, p in self.outbox if at <= self.t]
         if sent:

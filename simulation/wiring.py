@@ -44,6 +44,11 @@ class Wiring:
         out.axle_resets.clear()
         return cmd
 
+    def at_rest(self, out: Outputs) -> bool:
+        """The commands last sent are what ``commands_from(out)`` would send now (the interlocking changed no output
+        since; its drives and door relays are read in place)."""
+        return self._lit and not out.changed_signals and not out.axle_resets
+
     def publish(self, board: RelayBoard, everything: bool = False) -> None:
         f = self.field
         ch = f.take_changes()

@@ -1,6 +1,6 @@
 """The oracle watching a running :class:`~simulation.sim.Simulation`: after every cycle and every command.
 
-``Watch(sim)`` wraps ``sim.step`` and ``sim.command``; every finding is kept once, when it starts, as a
+``Watch(sim)`` wraps ``sim.step``, ``sim.rest`` and ``sim.command``; every finding is kept once, when it starts, as a
 :class:`Violation` (or, for what the interlocking cannot see, a hazard). The simulation is read through
 :class:`SimulationView`: the field's lamps, switch machines, relays, wheelsets and doors, the virtual neighbours'
 block machines, and the console's answer to "is this turnout locked".
@@ -163,8 +163,20 @@ class Watch:
             self.note(line, result)
             return result
 
+        rest = sim.rest
+
+        def watched_rest(limit: int) -> int:
+            # cycles at rest change nothing the oracle reads (its signature stays), so they are checked by counting,
+            # unless a finding waits for the interlocking's answer or an overlap's time runs (``Oracle.busy``)
+            if self.oracle.busy():
+                return 0
+            n = rest(limit)
+            self.cycles += n
+            return n
+
         sim.step = checked_step  # type: ignore[method-assign]
         sim.command = noted_command  # type: ignore[method-assign]
+        sim.rest = watched_rest  # type: ignore[method-assign]
 
     def note(self, line: str, result: Result) -> None:
         try:

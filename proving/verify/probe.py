@@ -95,20 +95,35 @@ class Probe:
         return result
 
     def run(self, seconds: float) -> None:
+        """Run ``seconds`` of simulated time (at least a cycle); the stretches at rest (``World.rest``) in one go."""
         n = max(1, round(seconds / self.ctx.cycle_s))
-        for _ in range(n):
-            self.sim.step()
+        sim = self.sim
+        i = 0
+        while i < n:
+            i += sim.rest(n - i)
+            if i < n:
+                sim.step()
+                i += 1
         self._cycles += n
         self._oracle()
 
     def until(self, done: Callable[[], bool], timeout_s: float) -> bool:
-        """Run cycle by cycle until ``done()`` holds or ``timeout_s`` of simulated time passed."""
-        for _ in range(round(timeout_s / self.ctx.cycle_s)):
+        """Run cycle by cycle until ``done()`` holds or ``timeout_s`` of simulated time passed. ``done`` reads the
+        simulation's state, which a stretch at rest leaves as it was: it is asked again after the next real cycle."""
+        sim = self.sim
+        total = round(timeout_s / self.ctx.cycle_s)
+        i = 0
+        while i < total:
             if done():
                 self._oracle()
                 return True
-            self.sim.step()
-            self._cycles += 1
+            rested = sim.rest(total - i)
+            i += rested
+            self._cycles += rested
+            if i < total:
+                sim.step()
+                self._cycles += 1
+                i += 1
         self._oracle()
         return done()
 
@@ -121,13 +136,22 @@ class Probe:
         that would only show the same state again. ``timeout_s`` only bounds a wait on turnouts that never rest: the
         rounds of moves the interlocking makes at once, each up to its time-out, end well before it."""
         rest = max(1, round(REST_S / self.ctx.cycle_s))
-        still = 0
-        for _ in range(round(timeout_s / self.ctx.cycle_s)):
-            if still >= rest:
-                break
-            self.sim.step()
+        sim = self.sim
+        total = round(timeout_s / self.ctx.cycle_s)
+        still = i = 0
+        busy = False
+        while i < total and still < rest:
+            # a stretch at rest leaves the turnouts as they are: busy as after the last real cycle
+            rested = sim.rest(total - i if busy else min(total - i, rest - still)) if i else 0
+            if rested:
+                i += rested
+                self._cycles += rested
+                still = 0 if busy else still + rested
+                continue
+            sim.step()
             self._cycles += 1
-            busy = self.sim.view.driving() or self.sim.field.machines_running()
+            i += 1
+            busy = bool(sim.view.driving() or sim.field.machines_running())
             still = 0 if busy else still + 1
         self._oracle()
 
