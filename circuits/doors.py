@@ -45,18 +45,21 @@ class PlatformDoors:
 
     def still_under(self, zckj: bool, kmj: bool, gmj: bool) -> bool:
         """Standing still, and :meth:`command` with these relays would not set it moving."""
-        if self.moving:
-            return False
-        opens = kmj and zckj and not self.faults.no_open and not gmj
-        closes = gmj and not self.faults.no_close and self.opening > 0.0
-        return not (opens or closes)
+        return not self.moving and not self._set_moving(zckj, kmj, gmj)
 
     def command(self, zckj: bool, kmj: bool, gmj: bool) -> None:
+        way = self._set_moving(zckj, kmj, gmj)
+        if way:
+            self.moving = way
+
+    def _set_moving(self, zckj: bool, kmj: bool, gmj: bool) -> int:
+        """The way these relays set the doors moving: +1 opening, -1 closing, 0 as they are."""
         authorised = zckj and not self.faults.no_open
         if kmj and authorised and not gmj:
-            self.moving = 1
-        elif gmj and not self.faults.no_close and self.opening > 0.0:
-            self.moving = -1
+            return 1
+        if gmj and not self.faults.no_close and self.opening > 0.0:
+            return -1
+        return 0
 
     def step(self, dt: float) -> bool:
         """Advance the doors; True when PDKJ may have changed."""

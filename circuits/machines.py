@@ -79,13 +79,11 @@ class SwitchMachine:
     # ---- commands and time ------------------------------------------------------------------------------------
     def drive(self, target: str | None) -> None:
         """The interlocking's drive command (None: no drive)."""
+        if not self.drive_changes(target):
+            return
         if target is None:
             self.running = False
             self.target = None
-            return
-        if target == self.target and self.running:
-            return
-        if target == self.rails and self.locked and self.target is None:
             return
         self.target = target
         self.running = True
@@ -94,7 +92,8 @@ class SwitchMachine:
         self.rails = None if self.rails != target else self.rails
 
     def drive_changes(self, target: str | None) -> bool:
-        """Would :meth:`drive` with ``target`` change anything?"""
+        """Would :meth:`drive` with ``target`` change anything? Not a drive to where it is already going, nor to
+        where its rails already lie locked with no move under way."""
         if target is None:
             return self.running or self.target is not None
         if target == self.target and self.running:
@@ -110,7 +109,7 @@ class SwitchMachine:
         while True:
             progress += dt
             n += 1
-            if not progress + 1e-9 < self.spec.throw_s:
+            if self._thrown(progress):
                 return n
 
     def coast(self, dt: float, n: int) -> None:
@@ -120,6 +119,10 @@ class SwitchMachine:
         for _ in range(n):
             self.progress += dt
 
+    def _thrown(self, progress: float) -> bool:
+        """``progress`` seconds of movement have brought the rails over (the step that gets there ends the move)."""
+        return not progress + 1e-9 < self.spec.throw_s
+
     def step(self, dt: float) -> bool:
         """Advance the motor; True when the indication may have changed."""
         if not self.running or self.target is None:
@@ -127,7 +130,7 @@ class SwitchMachine:
         if self.clutch_slips:
             return False  # the motor runs, the clutch slips, the rails do not move
         self.progress += dt
-        if self.progress + 1e-9 < self.spec.throw_s:
+        if not self._thrown(self.progress):
             return False
         self.rails = self.target
         self.running = False

@@ -244,7 +244,7 @@ class Core:
                 ts.target = None
                 ts.move_started = None
                 self.clear_alarm("move", t_id)
-            elif ts.move_started is not None and self.now - ts.move_started > self.rules.turnout_timeout_s:
+            elif ts.move_timed_out(self.now, self.rules.turnout_timeout_s):
                 self.moving.discard(t_id)
                 self.out.drive(t_id, None)
                 self.alarm("move", t_id, f"turnout {t_id} did not reach {ts.target} within "
@@ -268,15 +268,21 @@ class Core:
             self.moving.add(t_id)
             ts.move_started = self.now
             self.out.drive(t_id, ts.target)
+        for ts in self.squeeze_watched():
+            if ts.squeeze_due(self.now, self.rules.squeeze_alarm_s):
+                ts.squeeze_alarmed = True
+                self.alarm("squeeze", ts.id, f"turnout {ts.id} squeezed (挤岔): no indication for "
+                           f"{self.rules.squeeze_alarm_s:g} s")
+
+    def squeeze_watched(self) -> list[TurnoutState]:
+        """Turnouts without indication that the squeeze alarm watches: trailable, not moving or waiting to move,
+        not alarmed yet."""
+        out = []
         for t_id in self.no_indication:
             ts = self.turnouts[t_id]
-            if t_id in self.moving or ts.queued or ts.squeeze_alarmed or not ts.trailable:
-                continue
-            since = ts.no_indication_since if ts.no_indication_since is not None else 0.0
-            if self.now - since >= self.rules.squeeze_alarm_s:
-                ts.squeeze_alarmed = True
-                self.alarm("squeeze", t_id, f"turnout {t_id} squeezed (挤岔): no indication for "
-                           f"{self.rules.squeeze_alarm_s:g} s")
+            if not (t_id in self.moving or ts.queued or ts.squeeze_alarmed or not ts.trailable):
+                out.append(ts)
+        return out
 
     def request_move(self, turnout: str, position: str) -> None:
         """Queue a move of ``turnout`` (and its crossover partner) to ``position``."""

@@ -6,7 +6,8 @@ A cycle is a function of the interlocking's state, its relay inputs and the time
 lines, alarms, events, locks and outputs stayed as they were), the next cycle starts from the same state with the
 same relays, so it changes nothing either, unless one of the time conditions read in a cycle turns: a turnout's
 move time-out, the squeeze alarm of a turnout without indication, a time release, an overlap's release time. A
-:class:`Quiet` keeps those conditions, worked out with the very expressions the cycle uses, and
+:class:`Quiet` keeps those conditions, asked with the very rules the cycle asks (``TurnoutState.move_timed_out``,
+``squeeze_due``, ``Core.squeeze_watched``), and
 :meth:`~.cbi.Interlocking.cycle` runs no cycle while it holds (it only moves the clock and the cycle count).
 
 tests/test_quiet_same.py runs the real cycle in place of every quiet one and compares the whole state (pickled, not
@@ -18,7 +19,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-from .state import RouteStage
+from .state import RouteStage, TurnoutState
 
 if TYPE_CHECKING:
     from .core import Changes, Core
@@ -47,16 +48,17 @@ class Mark:
 class Quiet:
     """The time conditions that would make the next cycle act (each as the cycle writes it, negated)."""
 
-    moves: tuple[float, ...]  # move_started of the turnouts being driven: time-out once now - it > timeout_s
+    moves: tuple[TurnoutState, ...]  # the turnouts being driven: their move time-out
     timeout_s: float
-    squeezes: tuple[float, ...]  # since when turnouts without indication have none: squeeze alarm once now - it >= s
+    squeezes: tuple[TurnoutState, ...]  # the turnouts the squeeze alarm watches
     squeeze_s: float
     due: tuple[float, ...]  # time releases and overlap releases: once now >= it
 
     def holds(self, now: float) -> bool:
-        """A cycle at ``now`` would change nothing (with no relay changed and no command since the last cycle)."""
-        return (all(not now - s > self.timeout_s for s in self.moves)
-                and all(not now - s >= self.squeeze_s for s in self.squeezes)
+        """A cycle at ``now`` would change nothing (with no relay changed and no command since the last cycle).
+        The turnouts' states are the interlocking's own: nothing changes them while it rests."""
+        return (not any(ts.move_timed_out(now, self.timeout_s) for ts in self.moves)
+                and not any(ts.squeeze_due(now, self.squeeze_s) for ts in self.squeezes)
                 and all(not now >= at for at in self.due))
 
 
@@ -74,14 +76,9 @@ def quiet_after(core: Core, before: Mark, changes: Changes, routes_settled: bool
         return None
     if core.queue and len(core.moving) < core.rules.turnout_concurrency:
         return None
-    turnouts = core.turnouts
-    moves = tuple(ts.move_started for t in core.moving if (ts := turnouts[t]).move_started is not None)
-    squeezes = []
-    for t in core.no_indication:
-        ts = turnouts[t]
-        if not (t in core.moving or ts.queued or ts.squeeze_alarmed or not ts.trailable):
-            squeezes.append(ts.no_indication_since if ts.no_indication_since is not None else 0.0)
+    moves = tuple(core.turnouts[t] for t in core.moving)
     due = [at for at in core.overlap_pending.values() if at is not None]
     due += [rs.release_at for rs in core.routes.values()
             if rs.stage is RouteStage.time_release and rs.release_at is not None]
-    return Quiet(moves, core.rules.turnout_timeout_s, tuple(squeezes), core.rules.squeeze_alarm_s, tuple(due))
+    return Quiet(moves, core.rules.turnout_timeout_s, tuple(core.squeeze_watched()), core.rules.squeeze_alarm_s,
+                 tuple(due))

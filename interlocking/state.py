@@ -192,6 +192,15 @@ class TurnoutState:
     no_indication_since: float | None = None
     squeeze_alarmed: bool = False
 
+    def move_timed_out(self, now: float, timeout_s: float) -> bool:
+        """A move under way for longer than ``timeout_s`` (13 s + 3 s) without its indication."""
+        return self.move_started is not None and now - self.move_started > timeout_s
+
+    def squeeze_due(self, now: float, squeeze_s: float) -> bool:
+        """Without indication for ``squeeze_s`` (the squeeze alarm, 挤岔), counted from the start if never seen."""
+        since = self.no_indication_since if self.no_indication_since is not None else 0.0
+        return now - since >= squeeze_s
+
 
 @dataclass
 class SignalState:
