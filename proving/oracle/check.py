@@ -91,6 +91,7 @@ class Tables:
         self.role = {s: sec.role for s, sec in station.sections.items()}
         self.section_of = {t: tr.section for t, tr in station.tracks.items()}
         self.turnout_section = dict(station.turnout_section)
+        self.turnout_sections = sorted(set(self.turnout_section.values()))  # each once (a crossover's share one)
         self.turnout_tracks = {t: {tid for _, tid in station.node_tracks[t]} for t in station.turnouts}
         self.pair_of = {t.id: t.pair for t in station.model.turnouts if t.pair}
 
@@ -114,6 +115,7 @@ class Oracle:
         self.role = tables.role
         self.section_of = tables.section_of
         self.turnout_section = tables.turnout_section
+        self.turnout_sections = tables.turnout_sections
         self.turnout_tracks = tables.turnout_tracks
         self.pair_of = tables.pair_of
         # what the oracle remembers between checks
@@ -131,7 +133,7 @@ class Oracle:
         # sections the operator released by section fault release (区故解) while a movement's authority still reached
         # over them: the interlocking grants it on the operator's word, so what follows there is a hazard
         self.fault_released: set[str] = set()
-        self.turnout_sections_clear: dict[str, bool] = {}  # turnout sections as they were at the last check
+        self.turnout_sections_occupied: set[str] = set()  # turnout sections occupied at the last check
         self.now = 0.0
 
     def busy(self) -> bool:
@@ -500,7 +502,7 @@ class Oracle:
                 # occupied before the interlocking could see it (a movement entering as the move began, such as a
                 # train passing a signal at danger) is the world's hazard; occupied before that, the interlocking's
                 key = f"moved:{t}:occupied"
-                late = self.turnout_sections_clear.get(sec, True)
+                late = sec not in self.turnout_sections_occupied
                 found[key] = Finding(key, "moved", f"turnout {t} started moving towards {target} with its section "
                                      f"{sec} occupied" + (" (entered as the move began)" if late else ""),
                                      hazard=late)
@@ -513,5 +515,6 @@ class Oracle:
                                      f"does not see ({near[0][0]} at {near[0][1]:g} m; {sec} shows clear)",
                                      hazard=True)
         self.was_moving = moving
-        self.turnout_sections_clear = {sec: view.clear(sec) for sec in self.turnout_section.values()}
+        clear = view.clear
+        self.turnout_sections_occupied = {sec for sec in self.turnout_sections if not clear(sec)}
 
