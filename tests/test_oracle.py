@@ -150,6 +150,31 @@ def test_a_turnout_moved_under_an_open_signal_is_caught() -> None:
         [v.text for v in watch.violations]
 
 
+def test_a_turnout_driven_under_a_standing_vehicle_is_a_violation_under_one_entering_a_hazard() -> None:
+    """The interlocking's output drives a turnout whose section is occupied (a defect: its own checks are skipped).
+    Occupied since before, the interlocking could see it: a violation. Occupied in the very step the move begins
+    (a vehicle entering as the machine starts), it could not: the world's hazard."""
+    sim = Simulation("jiaopei")
+    watch = Watch(sim)
+    sim.command("occupy 7DG")
+    sim.command("run 2s")
+    sim.interlocking.core.out.drive("7", "reverse")
+    sim.command("run 1s")
+    assert [v.text for v in watch.violations] == ["turnout 7 started moving towards reverse with its section 7DG "
+                                                  "occupied"]
+    assert watch.hazards == []
+
+    sim = Simulation("jiaopei")
+    watch = Watch(sim)
+    sim.command("run 1s")
+    sim.interlocking.core.out.drive("7", "reverse")
+    sim.command("occupy 7DG")
+    sim.command("run 1s")
+    assert watch.violations == []
+    assert [v.text for v in watch.hazards] == ["turnout 7 started moving towards reverse with its section 7DG "
+                                               "occupied (entered as the move began)"]
+
+
 def test_a_signal_reopening_by_itself_is_caught() -> None:
     lines = ("route X XI", "run 2s", "fault no-indication 1", "run 1s", "repair no-indication 1", "run 2s")
     watch = run_lines("jiaopei", *lines, mutant="reopens-by-itself")
