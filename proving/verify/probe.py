@@ -94,36 +94,33 @@ class Probe:
         self._oracle()
         return result
 
+    def _forward(self, limit: int) -> int:
+        """Up to ``limit`` cycles at rest in one go (``World.rest``), else one real cycle; how many ran."""
+        n = self.sim.rest(limit)
+        if not n:
+            self.sim.step()
+            n = 1
+        self._cycles += n
+        return n
+
     def run(self, seconds: float) -> None:
-        """Run ``seconds`` of simulated time (at least a cycle); the stretches at rest (``World.rest``) in one go."""
+        """Run ``seconds`` of simulated time (at least a cycle); the stretches at rest in one go."""
         n = max(1, round(seconds / self.ctx.cycle_s))
-        sim = self.sim
         i = 0
         while i < n:
-            i += sim.rest(n - i)
-            if i < n:
-                sim.step()
-                i += 1
-        self._cycles += n
+            i += self._forward(n - i)
         self._oracle()
 
     def until(self, done: Callable[[], bool], timeout_s: float) -> bool:
-        """Run cycle by cycle until ``done()`` holds or ``timeout_s`` of simulated time passed. ``done`` reads the
-        simulation's state, which a stretch at rest leaves as it was: it is asked again after the next real cycle."""
-        sim = self.sim
+        """Run until ``done()`` holds or ``timeout_s`` of simulated time passed, asking it after every cycle or
+        stretch at rest (which leaves what it reads as it was)."""
         total = round(timeout_s / self.ctx.cycle_s)
         i = 0
         while i < total:
             if done():
                 self._oracle()
                 return True
-            rested = sim.rest(total - i)
-            i += rested
-            self._cycles += rested
-            if i < total:
-                sim.step()
-                self._cycles += 1
-                i += 1
+            i += self._forward(total - i)
         self._oracle()
         return done()
 
