@@ -8,6 +8,7 @@ import time
 from dataclasses import dataclass
 from typing import Any
 
+from liansuo import native_modules
 from liansuo.interlocking.table import build_table
 from liansuo.proving.progress import Advance, progress
 from liansuo.stations.fit import fit_all
@@ -115,6 +116,8 @@ def _run(sizes: Sizes, quick: bool, stations: tuple[str, ...], scale: ScaleSizes
         "benchmark": "liansuo bench",
         "mode": "quick" if quick else ("custom" if sizes != Sizes() else "full"),
         "machine": machine(),
+        # the modules that ran compiled (a native build, docs/native.md); [] for the Python sources
+        "native": native_modules(),
         "cycle_s": 0.25,
         "results": results,
         "zpw": zpw,
@@ -158,7 +161,8 @@ _TEXT_ROWS = [
 def as_text(report: dict[str, Any]) -> str:
     m = report["machine"]
     lines = [f"liansuo bench ({report['mode']}) on {m['cpu_model'] or m['processor'] or m['machine']}, "
-             f"{m['cpu_count']} CPUs, Python {m['python']}"]
+             f"{m['cpu_count']} CPUs, Python {m['python']}, "
+             + (f"native build ({len(report['native'])} modules compiled)" if report.get("native") else "pure Python")]
     results = report["results"]
     keys = list(results)
     lines.append(f"{'':26}" + "".join(f"{results[k]['station']:>14}" for k in keys))

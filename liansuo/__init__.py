@@ -21,7 +21,18 @@ does not import the others.
 
 from __future__ import annotations
 
+import os
+import sys
 from importlib import import_module
+from importlib.machinery import (
+    BYTECODE_SUFFIXES,
+    EXTENSION_SUFFIXES,
+    SOURCE_SUFFIXES,
+    FileFinder,
+    ModuleSpec,
+    SourceFileLoader,
+    SourcelessFileLoader,
+)
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
@@ -54,7 +65,46 @@ _WHERE = {
 }
 
 __all__ = ["InterlockingTable", "Result", "Route", "Simulation", "Station", "StationError", "UnknownId",
-           "VerifyReport", "__version__", "build_table", "load_station", "load_station_text", "verify_station"]
+           "VerifyReport", "__version__", "build_table", "load_station", "load_station_text", "native_modules",
+           "use_pure", "verify_station"]
+
+
+class _PureFinder:
+    """Finds liansuo's modules among its Python sources only, passing over the compiled ones of a native build."""
+
+    def find_spec(self, fullname: str, path: Any = None, target: Any = None) -> ModuleSpec | None:
+        if not fullname.startswith("liansuo.") or path is None:
+            return None
+        for where in path:
+            spec = FileFinder(where, (SourceFileLoader, SOURCE_SUFFIXES),
+                              (SourcelessFileLoader, BYTECODE_SUFFIXES)).find_spec(fullname, target)
+            if spec is not None:
+                return spec
+        return None
+
+
+def native_modules() -> list[str]:
+    """The modules of liansuo loaded so far that run compiled (a native build without LIANSUO_PURE=1)."""
+    return sorted(name for name, mod in list(sys.modules.items()) if name.startswith("liansuo.")
+                  and (getattr(mod, "__file__", None) or "").endswith(tuple(EXTENSION_SUFFIXES)))
+
+
+def use_pure() -> None:
+    """Run the Python sources of liansuo's modules from now on, in this process and the processes it starts. Asked
+    before any of them is imported compiled (the suite's tests/conftest.py), else it raises."""
+    os.environ["LIANSUO_PURE"] = "1"
+    if not any(isinstance(f, _PureFinder) for f in sys.meta_path):
+        sys.meta_path.insert(0, _PureFinder())
+    loaded = native_modules()
+    if loaded:
+        raise RuntimeError(f"liansuo's compiled modules are loaded already ({', '.join(loaded)}): set LIANSUO_PURE=1 "
+                           "in the environment to run the Python sources")
+
+
+# A native build (setup.py, docs/native.md) compiles the hot path with mypyc. LIANSUO_PURE=1 runs the Python sources
+# instead: what replaces a method at run time (``liansuo mutate``'s seeded defects, the suite's doubles) needs them.
+if os.environ.get("LIANSUO_PURE", "") == "1":
+    use_pure()
 
 
 def __getattr__(name: str) -> Any:

@@ -25,6 +25,7 @@ import liansuo.interlocking.locks as locks
 import liansuo.interlocking.operations as operations
 import liansuo.interlocking.state as state
 import liansuo.interlocking.stationblock as stationblock
+from liansuo import native_modules
 from liansuo.interlocking.io import RelayBoard, Result
 from liansuo.interlocking.route import Route
 from liansuo.interlocking.state import RouteStage, RouteState
@@ -43,6 +44,10 @@ class Mutant:
 
     @contextmanager
     def applied(self) -> Iterator[None]:
+        compiled = [m for m in native_modules() if m.startswith("liansuo.interlocking.")]
+        if compiled:  # a patch of a compiled module would change nothing, and the defect would go untried
+            raise RuntimeError(f"mutant {self.name}: the interlocking runs compiled ({', '.join(compiled)}); seeded "
+                               "defects need its Python sources (LIANSUO_PURE=1, or run_mutants)")
         with ExitStack() as stack:
             self.apply(stack)
             yield

@@ -11,12 +11,14 @@ import argparse
 import multiprocessing
 import os
 import time
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from concurrent.futures import ProcessPoolExecutor
+from contextlib import contextmanager
 from dataclasses import dataclass
 from importlib.resources import files
 from pathlib import Path
 
+from liansuo import native_modules
 from liansuo.stations.arguments import positive_int
 from liansuo.stations.exitcodes import Exit, bad_input, refuse
 from liansuo.stations.fit import fit_all
@@ -101,9 +103,28 @@ def run_mutants(stations: Iterable[str] | None = None, mutants: Iterable[Mutant]
     own so its patches never leak into another's run."""
     chosen = list(stations or default_stations())
     jobs = [(m.name, first_where_it_shows(chosen, m.first), soak_steps) for m in mutants]
-    with ProcessPoolExecutor(max_workers=workers or os.cpu_count() or 1,
-                             mp_context=multiprocessing.get_context("fork")) as pool:
+    # a seeded defect replaces a function or method, which compiled modules do not let happen: under a native build
+    # (setup.py) the mutants run in fresh processes on the Python sources (LIANSUO_PURE=1), else forked from this one
+    context = multiprocessing.get_context("spawn" if native_modules() else "fork")
+    with _pure_children(bool(native_modules())), \
+            ProcessPoolExecutor(max_workers=workers or os.cpu_count() or 1, mp_context=context) as pool:
         return list(pool.map(_one, jobs))
+
+
+@contextmanager
+def _pure_children(pure: bool) -> Iterator[None]:
+    """While it lasts, the processes started from this one run liansuo's Python sources when ``pure``."""
+    was = os.environ.get("LIANSUO_PURE")
+    if pure:
+        os.environ["LIANSUO_PURE"] = "1"
+    try:
+        yield
+    finally:
+        if pure:
+            if was is None:
+                os.environ.pop("LIANSUO_PURE", None)
+            else:
+                os.environ["LIANSUO_PURE"] = was
 
 
 def first_where_it_shows(stations: list[str], first: str) -> list[str]:

@@ -4,7 +4,13 @@ from __future__ import annotations
 
 import pytest
 
-from liansuo.simulation.sim import Simulation
+import liansuo
+
+# The suite runs the Python sources, in a native build too (setup.py): its doubles replace methods at run time, which
+# compiled classes do not allow. tests/test_native.py compares the compiled modules with them (pytest -m native).
+liansuo.use_pure()
+
+from liansuo.simulation.sim import Simulation  # noqa: E402
 
 
 class Driver:

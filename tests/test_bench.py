@@ -38,6 +38,7 @@ def test_report_has_every_figure_positive_and_finite(report: dict[str, object]) 
     machine = report["machine"]
     assert isinstance(machine, dict)
     assert {"processor", "cpu_count", "python"} <= machine.keys()
+    assert report["native"] == []  # the suite runs the Python sources (tests/conftest.py), and says so
     results = report["results"]
     assert isinstance(results, dict)
     assert set(results) == {"hub", "jiaopei"}
