@@ -13,15 +13,18 @@ from setuptools import setup
 # Compiled modules must keep to what mypyc supports: no class of theirs subclassed by a Python class, no method
 # of theirs replaced on an instance or a class at run time. What must replace them (the seeded defects of
 # ``liansuo mutate``, the suite's counting doubles) runs on the pure modules (``LIANSUO_PURE=1``, liansuo/__init__.py).
+# The station model (stations/station, topology) stays Python: compiled, deriving a 200-turnout hub's table took
+# over ten minutes instead of seconds (tried 2026-11-24; the cause was not looked into).
 NATIVE = [
     "circuits/field", "circuits/lamps", "circuits/machines", "circuits/shunts", "circuits/trackcircuits",
     "interlocking/cbi", "interlocking/core", "interlocking/io", "interlocking/lifecycle", "interlocking/locks",
-    "interlocking/quiet",
-    "simulation/wiring",
+    "interlocking/operations", "interlocking/quiet", "interlocking/state",
+    "simulation/commands", "simulation/neighbour", "simulation/view", "simulation/wiring",
     "simulation/trains/cabsignal", "simulation/trains/drivers", "simulation/trains/fleet",
     "simulation/trains/movement", "simulation/trains/odometerfeed", "simulation/trains/wheelsets",
-    "proving/oracle/authority", "proving/oracle/ceiling", "proving/oracle/check", "proving/oracle/meet",
-    "proving/oracle/watch",
+    "proving/oracle/authority", "proving/oracle/ceiling", "proving/oracle/check", "proving/oracle/flank",
+    "proving/oracle/lamps", "proving/oracle/meet", "proving/oracle/watch",
+    "proving/verify/pairs", "proving/verify/probe",
 ]
 
 

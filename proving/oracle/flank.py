@@ -16,7 +16,6 @@ section: a vehicle standing there fouls the path, so it must be clear.
 
 from __future__ import annotations
 
-import copy
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
@@ -42,26 +41,33 @@ def clearance_m(station: Station, rules: RuleSet) -> float:
 
 
 class Flank:
-    def __init__(self, station: Station, clearance_m: float) -> None:
+    def __init__(self, station: Station, clearance_m: float, *, tables_of: Flank | None = None) -> None:
+        """``tables_of``: a flank whose tables to share (they never change once made) instead of working them out."""
         self.st = station
+        self._cache: dict[tuple[str, ...], tuple[dict[str, Demand], list[str]]] = {}
+        self.role: dict[str, SectionRole]
+        self.fouled: set[str]
+        self.partners: dict[str, list[str]]
+        self.limit: dict[str, float]
+        if tables_of is not None:
+            self.role, self.fouled = tables_of.role, tables_of.fouled
+            self.partners, self.limit = tables_of.partners, tables_of.limit
+            return
         self.role = {t: station.sections[tr.section].role for t, tr in station.tracks.items()}
         self.fouled = {fp.track for fp in station.model.fouling_points if fp.track is not None}
         self.partners = {t: [m for m in members if m != t] for members in station.pairs.values() for t in members}
         # turnout -> how far along its legs the fouling limit reaches: a tied fouling point's distance from the
         # turnout, plus the clearance a vehicle needs past it
-        self.limit: dict[str, float] = {}
+        self.limit = {}
         for fp in station.model.fouling_points:
             if fp.turnout is not None:
                 reach = abs(fp.at - station.turnouts[fp.turnout].at) + clearance_m
                 self.limit[fp.turnout] = max(reach, self.limit.get(fp.turnout, 0.0))
-        self._cache: dict[tuple[str, ...], tuple[dict[str, Demand], list[str]]] = {}
 
     def fresh(self) -> Flank:
-        """A flank of its own over the same tables (they never change once made), its memo empty: the memo is keyed
-        by a path's tracks alone, so an oracle keeps it to itself, as when it built its flank."""
-        out = copy.copy(self)
-        out._cache = {}
-        return out
+        """A flank of its own over the same tables, its memo empty: the memo is keyed by a path's tracks alone, so an
+        oracle keeps it to itself, as when it built its flank."""
+        return Flank(self.st, 0.0, tables_of=self)
 
     def of(self, tracks: Sequence[str], turnouts: Mapping[str, str]) -> tuple[dict[str, Demand], list[str]]:
         """(flank turnout -> demand, fouling sections) for a path over ``tracks`` with ``turnouts`` in it."""
