@@ -29,7 +29,7 @@ test: $(STAMP)
 	$(BIN)/ruff check .
 	$(BIN)/mypy
 
-# The hot path compiled with mypyc (setup.py, docs/native.md): about 1.3-1.9x faster, the same results. Needs a C
+# The hot path compiled with mypyc (setup.py, docs/native.md): about 1.5-2x faster, the same results. Needs a C
 # compiler and Python's headers; `make clean` goes back to pure Python. `make test` runs the suite on the pure
 # modules either way (tests/conftest.py) and tests/test_native.py compares the two (pytest -m native).
 native: $(STAMP)

@@ -1,6 +1,6 @@
 """The build: pure Python by default. With ``LIANSUO_NATIVE=1`` in the environment the modules of the hot path (the
 cycle of the field, the interlocking and the trains, and the safety oracle) are also compiled to C extensions with
-mypyc (part of mypy), which runs them about 1.3-1.9x faster with the same results (docs/native.md). Everything else
+mypyc (part of mypy), which runs them about 1.5-2x faster with the same results (docs/native.md). Everything else
 about the package is in pyproject.toml.
 """
 

@@ -1,13 +1,14 @@
 """The native build against the Python sources: the same answers from the same installed wheel.
 
-A native build (``LIANSUO_NATIVE=1 pip wheel --no-build-isolation .``, setup.py, docs/native.md) compiles the hot path with mypyc. The
-wheel is built as a user builds it, from a copy of the checkout, and installed outside it; every command below then
-runs twice in fresh processes on that install: compiled, and on its Python sources (``LIANSUO_PURE=1``). The rest of
-the suite runs the Python sources only (tests/conftest.py), so this comparison is what shows the compiled modules
-right: the interlocking test of every bundled and example station, random soak runs, the example scripts, and trains
-moving on a generated hub, each with the very same report (timings left out).
+A native build (``LIANSUO_NATIVE=1 pip wheel --no-build-isolation .``, setup.py, docs/native.md) compiles the hot
+path with mypyc. The wheel is built as a user builds it, from a copy of the checkout, and installed outside it; every
+command below then runs twice in fresh processes on that install: compiled, and on its Python sources
+(``LIANSUO_PURE=1``). The rest of the suite runs the Python sources only (tests/conftest.py), so this comparison is
+what shows the compiled modules right: the interlocking test of every bundled and example station, random soak runs,
+the example scripts, and trains moving on a generated hub, each with the very same report (timings left out).
 
-It builds for about a minute, so it runs on demand: ``pytest -m native`` (``make test-native``).
+It takes about three and a half minutes (two of them building), so it runs on demand: ``pytest -m native``
+(``make test-native``).
 """
 
 from __future__ import annotations
@@ -76,7 +77,7 @@ def installed(tmp_path_factory: pytest.TempPathFactory) -> Path:
     env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "LIANSUO_PURE")}
     env["LIANSUO_NATIVE"] = "1"
     # mypyc type-checks what it compiles, so the build runs in this environment, which has mypy and the dependencies
-    assert int(version("setuptools").split(".")[0]) >= 77, "the build needs setuptools>=77: make test-native installs it"
+    assert int(version("setuptools").split(".")[0]) >= 77, "the build needs setuptools>=77 (make test-native has it)"
     built = subprocess.run([sys.executable, "-m", "pip", "wheel", "--no-deps", "--no-build-isolation", "--wheel-dir",
                             str(tmp / "dist"), str(source)], capture_output=True, text=True, env=env, timeout=900)
     assert built.returncode == 0, f"the native wheel did not build:\n{built.stdout[-3000:]}\n{built.stderr[-3000:]}"
