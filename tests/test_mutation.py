@@ -47,3 +47,18 @@ def test_each_mutant_is_tried_first_where_it_shows_and_then_everywhere_else() ->
     assert first_where_it_shows(["jiaopei", "hub:10:4"], "hub:10:4") == ["hub:10:4", "jiaopei"]
     assert first_where_it_shows(["jiaopei", "depot"], "") == ["jiaopei", "depot"]
     assert first_where_it_shows(["jiaopei", "depot"], "nowhere") == ["jiaopei", "depot"]
+
+
+def test_a_mutant_refuses_a_compiled_interlocking_rather_than_go_untried(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Under a native build (docs/native.md) a patch of a compiled module would change nothing: applying a mutant in
+    a process where the interlocking runs compiled must say so, not run verify on the sound interlocking. The suite
+    runs pure, so the compiled state is stood in for by what ``native_modules`` reports."""
+    import liansuo.proving.mutants as mutants
+
+    monkeypatch.setattr(mutants, "native_modules", lambda: ["liansuo.circuits.field", "liansuo.interlocking.core"])
+    with pytest.raises(RuntimeError, match=r"interlocking runs compiled \(liansuo.interlocking.core\).*LIANSUO_PURE"), \
+            MUTANTS[0].applied():
+        pass
+    monkeypatch.setattr(mutants, "native_modules", lambda: ["liansuo.circuits.field"])  # only the field compiled
+    with MUTANTS[0].applied():
+        pass

@@ -5,7 +5,8 @@ path with mypyc. The wheel is built as a user builds it, from a copy of the chec
 command below then runs twice in fresh processes on that install: compiled, and on its Python sources
 (``LIANSUO_PURE=1``). The rest of the suite runs the Python sources only (tests/conftest.py), so this comparison is
 what shows the compiled modules right: the interlocking test of every bundled and example station, random soak runs,
-the example scripts, and trains moving on a generated hub, each with the very same report (timings left out).
+the example scripts and scenarios, the track-circuit models, and trains moving on a generated hub, each with the very
+same report (timings left out). The console under a native build was tried by hand (docs/native.md).
 
 It takes about three and a half minutes (two of them building), so it runs on demand: ``pytest -m native``
 (``make test-native``).
@@ -145,6 +146,23 @@ def test_example_scripts_pass_the_same(installed: Path, tmp_path: Path) -> None:
     native, pure = both(installed, ["-m", "liansuo.cli", "test", *scripts, "--format", "json"], tmp_path)
     assert native == pure
     assert pure["passed"] > 0 and pure["failed"] == 0
+
+
+@pytest.mark.parametrize("scenario", sorted(p.name for p in (ROOT / "examples" / "scenarios").glob("*.yaml")))
+def test_scenarios_run_the_same(installed: Path, tmp_path: Path, scenario: str) -> None:
+    """Trains, faults and commands in time: every event of the log, at the same time, with the same text."""
+    native, pure = both(installed, ["-m", "liansuo.cli", "run", str(ROOT / "examples" / "scenarios" / scenario),
+                                    "--format", "json"], tmp_path)
+    assert native == pure
+    assert pure["events"]
+
+
+@pytest.mark.parametrize("args", [["zpw", "gaotie", "--fault", "X3JG:capacitor:5:open"], ["25hz", "jiaopei",
+                                                                                          "--section", "IG"]],
+                         ids=["zpw", "25hz"])
+def test_track_circuits_compute_the_same(installed: Path, tmp_path: Path, args: list[str]) -> None:
+    native, pure = both(installed, ["-m", "liansuo.cli", *args, "--format", "json"], tmp_path)
+    assert native == pure
 
 
 def test_trains_move_the_same(installed: Path, tmp_path: Path) -> None:
