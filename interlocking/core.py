@@ -225,7 +225,9 @@ class Core:
 
     # ---- turnouts -------------------------------------------------------------------------------------------
     def _supervise_turnouts(self) -> None:
-        for t_id in list(self.moving):
+        # in the order of their ids, not of a set's hashing, so that the events and alarms of one cycle come in the
+        # same order in every run (a set of strings iterates differently from one process to the next)
+        for t_id in sorted(self.moving):
             ts = self.turnouts[t_id]
             if not self.clear(ts.section) and self.board.indication(t_id) != ts.target:
                 # a movement entered the turnout's section during the move: stop driving it, so the machine is
@@ -278,7 +280,7 @@ class Core:
         """Turnouts without indication that the squeeze alarm watches: trailable, not moving or waiting to move,
         not alarmed yet."""
         out = []
-        for t_id in self.no_indication:
+        for t_id in sorted(self.no_indication):  # the alarms in the same order in every run
             ts = self.turnouts[t_id]
             if not (t_id in self.moving or ts.queued or ts.squeeze_alarmed or not ts.trailable):
                 out.append(ts)
