@@ -8,7 +8,7 @@ what shows the compiled modules right: the interlocking test of every bundled an
 the example scripts and scenarios, the track-circuit models, and trains moving on a generated hub, each with the very
 same report (timings left out). The console under a native build was tried by hand (docs/native.md).
 
-It takes about three and a half minutes (two of them building), so it runs on demand: ``pytest -m native``
+It takes about four minutes (two of them building), so it runs on demand: ``pytest -m native``
 (``make test-native``).
 """
 
