@@ -3,6 +3,7 @@ out on Dask with the same report, the table written row by row and the same on e
 
 from __future__ import annotations
 
+import copy
 import json
 import os
 import subprocess
@@ -13,7 +14,7 @@ from pathlib import Path
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from liansuo.interlocking.table import build_table
+from liansuo.interlocking.table import InterlockingTable, Route, build_table
 from liansuo.interlocking.tableformat import as_json
 from liansuo.proving.progress import progress
 from liansuo.proving.soakcli import soak_runs
@@ -84,12 +85,27 @@ def test_batches_are_ordered_to_move_the_fewest_turnouts_next() -> None:
     chain's earlier batches left them (all normal at a chain's start), counted here name by name."""
     table = build_table(load("gaotie"))
     batches: list[Batch] = [b for u in plan(table, None, pairs=True).units if u.kind == "batches" for b in u.batches]
-    routes = table.routes
+    _assert_ordered_by_moves(sorted(batches, key=lambda b: (len(b[0]), b[0])), table.routes)
 
+
+def test_batches_whose_routes_need_a_turnout_both_ways_are_ordered_by_the_last_route_naming_it() -> None:
+    """A table missing an enemy could put two routes needing one turnout both ways in a batch: the turnout then lies
+    as the batch's last route needs it, as it would once the batch is set."""
+    table = build_table(load("gaotie"))
+    routes = list(table.routes.values())
+    both_ways: list[Batch] = []
+    for a, b in combinations(routes, 2):
+        lie = {t.id: t.position for t in a.all_turnouts}
+        if any(lie.get(t.id, t.position) != t.position for t in b.all_turnouts):
+            both_ways += [((a.id, b.id), ()), ((b.id, a.id), ())]
+    assert len(both_ways) > 32
+    _assert_ordered_by_moves(both_ways, table.routes)
+
+
+def _assert_ordered_by_moves(shuffled: list[Batch], routes: dict[str, Route]) -> None:
     def needs(b: Batch) -> dict[str, str]:
         return {t.id: t.position.value for r in b[0] for t in routes[r].all_turnouts}
 
-    shuffled = sorted(batches, key=lambda b: (len(b[0]), b[0]))
     ordered = by_turnouts(shuffled, routes)
     assert sorted(ordered) == sorted(shuffled)
     left = sorted(shuffled, key=lambda b: (sorted(t for t, p in needs(b).items() if p == "reverse"),
@@ -117,6 +133,75 @@ def test_the_plan_covers_the_table_with_batches_and_counts_every_pair() -> None:
     assert proved == compatible
     assert len(batches) < len(compatible)  # batches prove several pairs at once
     assert [u.item for u in work.units if u.kind == "station"] == ["throats", "power-up", "red-lamp-transfer"]
+
+
+def _pair_units_by_scanning(table: InterlockingTable, focus: set[str] | None) -> tuple[list[tuple[str, ...]], list[
+        tuple[str, str]], list[tuple[str, str]], list[tuple[str, str]], tuple[int, int, int]]:
+    """What the plan's pair units must be, a pair at a time: each route's enemies (listed on either route, or the
+    same signal), the conditional pairs, the compatible pairs, the pairs listed on one route only, and the counts
+    (tested, conflicting, compatible; a conditional pair counts as both)."""
+    order = list(table.routes.values())
+    rivals, conditional, compatible, lopsided = [], [], [], []
+    tested = conflicting = fine = 0
+
+    def relevant(a: Route, b: Route) -> bool:
+        return not focus or a.id in focus or b.id in focus
+
+    def enemies(a: Route, b: Route) -> bool:
+        return b.id in a.conflicts or a.id in b.conflicts or a.signal == b.signal
+
+    for i, a in enumerate(order):
+        mine = [b.id for b in order if b is not a and enemies(a, b) and relevant(a, b)]
+        if mine:
+            rivals.append((a.id, *mine))
+        for b in order[i + 1:]:
+            if not relevant(a, b):
+                continue
+            tested += 1
+            if enemies(a, b):
+                conflicting += 1
+            elif b.id in a.conditional or a.id in b.conditional:
+                conflicting += 1
+                fine += 1
+                conditional.append((a.id, b.id))
+            else:
+                fine += 1
+                compatible.append((a.id, b.id))
+            if (b.id in a.conflicts) != (a.id in b.conflicts) or (b.id in a.conditional) != (a.id in b.conditional):
+                lopsided.append((a.id, b.id))
+    return rivals, conditional, compatible, lopsided, (tested, conflicting, fine)
+
+
+def _lopsided(table: InterlockingTable) -> InterlockingTable:
+    """``table`` with one conflict and one conditional conflict listed on one of their routes only."""
+    table = copy.deepcopy(table)
+    a = next(r for r in table.routes.values() if r.conflicts)
+    del a.conflicts[next(iter(a.conflicts))]
+    b = next((r for r in table.routes.values() if r.conditional), None)
+    if b is not None:
+        del b.conditional[next(iter(b.conditional))]
+    return table
+
+
+def test_the_plan_sorts_every_pair_as_a_test_a_pair_does() -> None:
+    """The plan finds enemies, conditional and compatible pairs with bit sets; here they are found a pair at a time,
+    on stations with conditional enemies (depot, doubleslip), with a focus, and on tables whose conflicts are listed
+    on one route only."""
+    for name in ("jiaopei", "depot", "gaotie", "examples/stations/doubleslip.yaml"):
+        built = build_table(load(name if "/" not in name else Path(__file__).parent.parent / name))
+        for table in (built, _lopsided(built)):
+            ids = list(table.routes)
+            for focus in (None, {ids[0], ids[len(ids) // 2]}):
+                work = plan(table, focus, pairs=True)
+                rivals, conditional, compatible, lopsided, counts = _pair_units_by_scanning(table, focus)
+                assert [u.routes for u in work.units if u.kind == "rivals"] == rivals
+                assert [u.routes for u in work.units if u.kind == "conditional"] == conditional
+                proved = [p for u in work.units if u.kind == "batches" for _, pairs in u.batches for p in pairs]
+                assert sorted(proved) == sorted(compatible)
+                assert work.asymmetric == lopsided
+                assert (work.pairs_tested, work.pairs_conflicting, work.pairs_compatible) == counts
+                assert [u.routes[0] for u in work.units if u.kind == "route"] == [
+                    r for r in ids if not focus or r in focus]
 
 
 def test_verify_on_two_dask_workers_reports_exactly_what_one_process_does() -> None:

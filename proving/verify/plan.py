@@ -16,7 +16,7 @@ simulation, each cancelled before the next is set: the turnouts the next needs o
 from __future__ import annotations
 
 import heapq
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
 
 from liansuo.interlocking.table import InterlockingTable, Route
@@ -79,40 +79,68 @@ def plan(table: InterlockingTable, focus: set[str] | None, *, pairs: bool) -> Pl
 
 
 def _pairs(order: list[Route], focus: set[str] | None) -> Plan:
-    def relevant(a: Route, b: Route) -> bool:
-        return not focus or a.id in focus or b.id in focus
+    """The pair units of ``order``: each route's enemies, the chains of batches of compatible routes, each
+    conditional pair. Who conflicts with whom is kept as bit sets (Python integers, bit ``j`` for ``order[j]``), so a
+    hub's millions of pairs are sorted in a few operations a route instead of a test a pair; the units and counts are
+    those of a test a pair (tests/test_scale.py holds them to it)."""
+    n = len(order)
+    index = {r.id: k for k, r in enumerate(order)}
+    listed = _masks(order, index, lambda r: r.conflicts)  # b in a.conflicts
+    listed_by = _transpose(listed, n)  # a in b.conflicts
+    cond = _masks(order, index, lambda r: r.conditional)
+    cond_by = _transpose(cond, n)
+    same_signal: dict[str, int] = {}
+    for k, r in enumerate(order):
+        same_signal[r.signal] = same_signal.get(r.signal, 0) | 1 << k
+    everyone = (1 << n) - 1
+    in_focus = sum(1 << k for k, r in enumerate(order) if r.id in focus) if focus else everyone
 
     out = Plan([])
     rivals: list[Unit] = []
     conditionals: list[Unit] = []
-    compatible: list[tuple[int, int]] = []
+    adj = [0] * n  # compatible pairs, both ways
     for i, a in enumerate(order):
-        mine = [b.id for b in order if b is not a and conflicting(a, b) and relevant(a, b)]
+        me = 1 << i
+        relevant = everyone if in_focus & me else in_focus
+        enemies = (listed[i] | listed_by[i] | same_signal[a.signal]) & ~me
+        mine = enemies & relevant
         if mine:
-            rivals.append(Unit("rivals", (a.id, *mine)))
-        for j in range(i + 1, len(order)):
-            b = order[j]
-            if not relevant(a, b):
-                continue
-            out.pairs_tested += 1
-            if conflicting(a, b):
-                out.pairs_conflicting += 1
-            elif conditional(a, b):
-                out.pairs_conflicting += 1
-                out.pairs_compatible += 1
-                conditionals.append(Unit("conditional", (a.id, b.id)))
-            else:
-                out.pairs_compatible += 1
-                compatible.append((i, j))
-            if (b.id in a.conflicts) != (a.id in b.conflicts) or (b.id in a.conditional) != (a.id in b.conditional):
-                out.asymmetric.append((a.id, b.id))
+            rivals.append(Unit("rivals", (a.id, *(order[j].id for j in _bits(mine)))))
+        later = relevant & ~((me << 1) - 1)  # j > i
+        out.pairs_tested += later.bit_count()
+        out.pairs_conflicting += (later & enemies).bit_count()
+        conditional_later = later & ~enemies & (cond[i] | cond_by[i])
+        out.pairs_conflicting += conditional_later.bit_count()
+        out.pairs_compatible += conditional_later.bit_count()
+        conditionals += [Unit("conditional", (a.id, order[j].id)) for j in _bits(conditional_later)]
+        compatible = later & ~enemies & ~conditional_later
+        out.pairs_compatible += compatible.bit_count()
+        adj[i] |= compatible
+        for j in _bits(compatible):
+            adj[j] |= me
+        lopsided = later & ((listed[i] ^ listed_by[i]) | (cond[i] ^ cond_by[i]))
+        out.asymmetric += [(a.id, order[j].id) for j in _bits(lopsided)]
     ids = [r.id for r in order]
     batches: list[Batch] = [(tuple(ids[k] for k in group), tuple((ids[x], ids[y]) for x, y in proved))
-                            for group, proved in cover(len(order), compatible)]
+                            for group, proved in cover_adjacent(adj)]
     batches = by_turnouts(batches, {r.id: r for r in order})
     chains = [Unit("batches", batches=tuple(batches[i:i + CHAIN])) for i in range(0, len(batches), CHAIN)]
     out.units = rivals + chains + conditionals
     return out
+
+
+def _masks(order: list[Route], index: dict[str, int], named: Callable[[Route], Iterable[str]]) -> list[int]:
+    """For each route, the bit set of the routes it names (its conflicts, its conditional enemies)."""
+    return [sum(1 << j for j in {index[x] for x in named(r) if x in index}) for r in order]
+
+
+def _transpose(masks: list[int], n: int) -> list[int]:
+    """Bit ``i`` of ``out[j]`` is bit ``j`` of ``masks[i]``: who names each route."""
+    named_by: list[list[int]] = [[] for _ in range(n)]
+    for i, m in enumerate(masks):
+        for j in _bits(m):
+            named_by[j].append(i)
+    return [sum(1 << i for i in who) for who in named_by]
 
 
 def by_turnouts(batches: list[Batch], routes: dict[str, Route], window: int = 32) -> list[Batch]:
@@ -123,16 +151,24 @@ def by_turnouts(batches: list[Batch], routes: dict[str, Route], window: int = 32
     bit: dict[str, int] = {}
     needs: list[tuple[int, int]] = []  # (every turnout the batch needs, those of them reversed)
     rev_names: list[list[str]] = []
+    lies: dict[str, tuple[int, int, frozenset[str]]] = {}  # each route's (turnouts, reversed ones, their names)
     for b in batches:
-        lie = {t.id: t.position.value for r in b[0] for t in routes[r].all_turnouts}
-        every = rev = 0
-        for t, p in lie.items():
-            k = bit.setdefault(t, 1 << len(bit))
-            every |= k
-            if p == "reverse":
-                rev |= k
+        every = rev = normal = 0
+        names: set[str] = set()
+        for r in b[0]:
+            if r not in lies:
+                lies[r] = _lie(routes[r], bit)
+            e, v, ns = lies[r]
+            every |= e
+            rev |= v
+            normal |= e & ~v
+            names |= ns
+        if rev & normal:  # a turnout two routes need lying both ways (an enemy the table missed): the last one wins
+            lie = {t.id: t.position.value for r in b[0] for t in routes[r].all_turnouts}
+            rev = sum(bit[t] for t, p in lie.items() if p == "reverse")
+            names = {t for t, p in lie.items() if p == "reverse"}
         needs.append((every, rev))
-        rev_names.append(sorted(t for t, p in lie.items() if p == "reverse"))
+        rev_names.append(sorted(names))
     left = sorted(range(len(batches)), key=lambda i: (rev_names[i], i))
     out: list[int] = []
     lying = 0  # the turnouts lying reverse now
@@ -148,6 +184,19 @@ def by_turnouts(batches: list[Batch], routes: dict[str, Route], window: int = 32
     return [batches[i] for i in out]
 
 
+def _lie(route: Route, bit: dict[str, int]) -> tuple[int, int, frozenset[str]]:
+    """The turnouts ``route`` needs and those it needs reversed, as bit sets (each turnout's bit given at its first
+    sight), and the names of the reversed ones; a turnout named twice lies as it is named last."""
+    lie = {t.id: t.position.value for t in route.all_turnouts}
+    every = rev = 0
+    for t, p in lie.items():
+        k = bit.setdefault(t, 1 << len(bit))
+        every |= k
+        if p == "reverse":
+            rev |= k
+    return every, rev, frozenset(t for t, p in lie.items() if p == "reverse")
+
+
 def cover(n: int, edges: Iterable[tuple[int, int]], max_size: int = MAX_BATCH
           ) -> list[tuple[list[int], list[tuple[int, int]]]]:
     """Groups of pairwise-adjacent vertices (cliques) of the graph on ``range(n)`` with ``edges`` until every edge
@@ -159,6 +208,11 @@ def cover(n: int, edges: Iterable[tuple[int, int]], max_size: int = MAX_BATCH
     for a, b in edges:
         adj[a] |= 1 << b
         adj[b] |= 1 << a
+    return cover_adjacent(adj, max_size)
+
+
+def cover_adjacent(adj: list[int], max_size: int = MAX_BATCH) -> list[tuple[list[int], list[tuple[int, int]]]]:
+    """:func:`cover` of the graph whose vertex ``v`` is adjacent to the bits of ``adj[v]``."""
     left = list(adj)  # uncovered edges at each vertex
     remaining = sum(x.bit_count() for x in left) // 2
     heap = [(-x.bit_count(), v) for v, x in enumerate(left)]  # counts only fall: stale entries are pushed again
@@ -202,11 +256,17 @@ def _most_left(heap: list[tuple[int, int]], left: list[int]) -> int:
 
 
 def _first_bits(x: int, k: int) -> list[int]:
+    """The ``k`` lowest set bits of ``x``, lowest first: found in its binary digits (one C-level search a bit), not
+    by peeling bits off a large integer one at a time."""
+    digits = bin(x)
+    last = len(digits) - 1
     out: list[int] = []
-    while x and len(out) < k:
-        low = x & -x
-        out.append(low.bit_length() - 1)
-        x ^= low
+    end = len(digits)
+    while len(out) < k:
+        end = digits.rfind("1", 2, end)
+        if end < 0:
+            break
+        out.append(last - end)
     return out
 
 
