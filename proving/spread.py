@@ -42,10 +42,13 @@ def client(workers: int, scheduler: str | None) -> Iterator[Any]:
         with c:
             yield c
         return
+    from .noprofiler import NoProfiler
+
     # the dashboard on any free port; the workers' chatter when the cluster shuts down is silenced
     cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,  # type: ignore[no-untyped-call]
                            dashboard_address=":0", silence_logs=logging.CRITICAL)
     with cluster, Client(cluster) as c:  # type: ignore[no-untyped-call]
+        c.register_plugin(NoProfiler())  # on every worker, and on any its nanny starts again
         yield c
 
 

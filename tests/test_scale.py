@@ -10,6 +10,7 @@ import subprocess
 import sys
 from itertools import combinations
 from pathlib import Path
+from typing import Any
 
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -18,6 +19,7 @@ from liansuo.interlocking.table import InterlockingTable, Route, build_table
 from liansuo.interlocking.tableformat import as_json
 from liansuo.proving.progress import progress
 from liansuo.proving.soakcli import soak_runs
+from liansuo.proving.spread import client
 from liansuo.proving.verify import verify_station
 from liansuo.proving.verify.plan import CHAIN, Batch, by_turnouts, cover, plan
 from liansuo.stations.loader import load, load_text
@@ -210,6 +212,18 @@ def test_verify_on_two_dask_workers_reports_exactly_what_one_process_does() -> N
     assert here.pop("elapsed_s") is not None and spread.pop("elapsed_s") is not None
     assert here["warnings"], "gaotie's dead-zone warnings should be in both reports"
     assert here == spread
+
+
+def test_local_workers_run_without_the_statistical_profiler() -> None:
+    """A Dask worker samples its task's stack every 10 ms for the dashboard; on verify's units that cost a quarter of
+    the worker's time, so the local cluster's workers run without it (and a worker its nanny restarts, too)."""
+    def profiling(dask_worker: Any) -> list[str]:
+        return [name for name in ("profile", "profile-cycle") if name in dask_worker.periodic_callbacks]
+
+    with client(2, None) as c:
+        assert list(c.run(profiling).values()) == [[], []]
+        c.restart()
+        assert list(c.run(profiling).values()) == [[], []]
 
 
 def test_soak_runs_on_workers_are_the_runs_made_here_in_seed_order() -> None:
