@@ -197,11 +197,66 @@ def compose(text: str, limits: InputLimits = LIMITS) -> Node | None:
         with _no_collection():
             return _compose(text, limits)
     except yaml.MarkedYAMLError as exc:
+        if exc.problem == _LIBYAML_TOO_DEEP:
+            raise _too_deep(text, limits, exc) from None
         raise _syntax(exc, text) from None
     except yaml.reader.ReaderError as exc:
         raise YamlProblem(text.count("\n", 0, exc.position) + 1, 1, f"cannot read the file: {exc.reason}") from None
     except yaml.YAMLError:
         raise YamlProblem(1, 1, "cannot read the file as YAML", "is this a YAML file?") from None
+
+
+def _too_deep(text: str, limits: InputLimits, exc: yaml.MarkedYAMLError) -> YamlProblem:
+    """Nesting deeper than libyaml's own limit (about 1,000 flow levels, PyYAML 6.0.4 on) is refused by its scanner
+    before our limit speaks in the events: the scanner looks far ahead inside flow collections. The text cut just past
+    the bracket that opens one flow level more than our limit is read again, so our limit speaks at its own place; if
+    that finds nothing (the brackets were not where a rough look saw them), the limit is named at libyaml's place."""
+    depth = _depth_message(limits)
+    cut = _past_flow_depth(text, limits.max_depth + 1)
+    if cut is not None:
+        try:
+            with _no_collection():
+                _compose(text[:cut], limits)
+        except YamlProblem as problem:
+            if problem.message == depth:
+                return problem
+        except yaml.YAMLError:
+            pass
+    mark = exc.problem_mark or exc.context_mark
+    line, col = (mark.line + 1, mark.column + 1) if mark else (1, 1)
+    return YamlProblem(line, col, depth, _DEPTH_HINT)
+
+
+def _past_flow_depth(text: str, depth: int) -> int | None:
+    """Just past the '[' or '{' that opens the ``depth``-th nested flow collection, passing over quoted values and
+    comments (roughly: a quote inside a plain value is taken for a quoted value); None when there is none."""
+    level, i, n = 0, 0, len(text)
+    while i < n:
+        c = text[i]
+        if c in "[{":
+            level += 1
+            if level >= depth:
+                return i + 1
+        elif c in "]}":
+            level = max(0, level - 1)
+        elif c == "#" and (i == 0 or text[i - 1] in " \t\n"):
+            end = text.find("\n", i)
+            i = n if end < 0 else end
+            continue
+        elif c in "'\"":
+            i += 1
+            while i < n and text[i] != c:
+                i += 2 if c == '"' and text[i] == "\\" else 1
+        i += 1
+    return None
+
+
+def _depth_message(limits: InputLimits) -> str:
+    return f"lists and mappings nested more than {limits.max_depth} deep"
+
+
+_LIBYAML_TOO_DEEP = "exceeded maximum nesting depth"  # the problem libyaml's scanner names past its own limit
+_DEPTH_HINT = "a liansuo file nests a few levels; check the indentation above"
 
 
 @contextmanager
@@ -250,8 +305,7 @@ def _compose(text: str, limits: InputLimits) -> Node | None:
                           "write the repeated parts out, or repeat less")
         elif isinstance(ev, SequenceStartEvent | MappingStartEvent):
             if len(stack) >= limits.max_depth:
-                raise _at(ev.start_mark, f"lists and mappings nested more than {limits.max_depth} deep",
-                          "a liansuo file nests a few levels; check the indentation above")
+                raise _at(ev.start_mark, _depth_message(limits), _DEPTH_HINT)
             seq = isinstance(ev, SequenceStartEvent)
             tag = (_SEQ if seq else _MAP) if ev.tag in (None, "!") else ev.tag
             if tag != (_SEQ if seq else _MAP):

@@ -96,6 +96,8 @@ def test_aliases_that_repeat_a_little_still_load(tmp_path: Path) -> None:
     ("id: &a minimal\nname: &a x\n", 2, 7, "the anchor '&a' is defined twice (first at line 1)"),
     ("id: minimal\ndeep: " + "[" * 100_000 + "]" * 100_000 + "\n", 2, 70, "lists and mappings nested more than "
                                                                           f"{LIMITS.max_depth} deep"),
+    ("id: minimal\n# [[[[ a comment [[\nkey: '[[[['\ndeep: " + "{a: " * 100_000 + "}" * 100_000 + "\n", 4, 259,
+     f"lists and mappings nested more than {LIMITS.max_depth} deep"),
     ("id: minimal\n---\nid: other\n", 2, 1, "a second YAML document ('---'): a liansuo file holds one"),
 ])
 def test_what_the_reader_refuses_is_reported_where_it_stands(
@@ -103,6 +105,18 @@ def test_what_the_reader_refuses_is_reported_where_it_stands(
     """Nesting 100,000 deep used to crash the process (YAML's C composer recursing), a self-referring alias to
     raise RecursionError."""
     assert refused_at(capsys, written(tmp_path, text), line, column) == message
+
+
+def test_nesting_past_the_yaml_library_s_own_limit_is_refused_in_our_words_where_it_cannot_be_placed_better(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """libyaml (PyYAML 6.0.4 on) refuses flow nesting past its own limit before the events reach ours; where the
+    reader cannot find the bracket that passes our limit (a quote in a plain value, here), the limit is named at
+    libyaml's place, on the right line, with no parser's words."""
+    path = written(tmp_path, "id: minimal\ndeep: [it's, " + "[" * 100_000 + "]" * 100_000 + "]\n")
+    code, out, err = run(capsys, "check", str(path))
+    assert code == 3 and out == ""
+    assert err.startswith(f"{path}:2:") and f": error: lists and mappings nested more than {LIMITS.max_depth} deep\n" \
+        in err, err
 
 
 def test_a_device_or_a_pipe_is_refused_without_being_read(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
