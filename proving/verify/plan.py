@@ -28,15 +28,6 @@ CHAIN = 32  # batches one after the other on one simulation (each cancelled befo
 _LOOK = 32  # candidates weighed for each place in a batch (more: fewer batches, longer planning)
 
 
-def conflicting(a: Route, b: Route) -> bool:
-    return b.id in a.conflicts or a.id in b.conflicts or a.signal == b.signal
-
-
-def conditional(a: Route, b: Route) -> bool:
-    """Enemies only for some ways the turnouts beyond a shunting route's end lie."""
-    return b.id in a.conditional or a.id in b.conditional
-
-
 Batch = tuple[tuple[str, ...], tuple[tuple[str, str], ...]]  # (routes set together, the pairs they prove)
 
 
