@@ -89,7 +89,7 @@ def _pairs(order: list[Route], focus: set[str] | None) -> Plan:
     out = Plan([])
     rivals: list[Unit] = []
     conditionals: list[Unit] = []
-    adj = [0] * n  # compatible pairs, both ways
+    adj = [0] * n  # each route's compatible partners (the relation is symmetric: so is every part of it)
     for i, a in enumerate(order):
         me = 1 << i
         relevant = everyone if in_focus & me else in_focus
@@ -100,15 +100,13 @@ def _pairs(order: list[Route], focus: set[str] | None) -> Plan:
         later = relevant & ~((me << 1) - 1)  # j > i
         out.pairs_tested += later.bit_count()
         out.pairs_conflicting += (later & enemies).bit_count()
-        conditional_later = later & ~enemies & (cond[i] | cond_by[i])
+        conditional = cond[i] | cond_by[i]
+        conditional_later = later & ~enemies & conditional
         out.pairs_conflicting += conditional_later.bit_count()
         out.pairs_compatible += conditional_later.bit_count()
         conditionals += [Unit("conditional", (a.id, order[j].id)) for j in _bits(conditional_later)]
-        compatible = later & ~enemies & ~conditional_later
-        out.pairs_compatible += compatible.bit_count()
-        adj[i] |= compatible
-        for j in _bits(compatible):
-            adj[j] |= me
+        adj[i] = relevant & ~enemies & ~conditional & ~me
+        out.pairs_compatible += (adj[i] & later).bit_count()
         lopsided = later & ((listed[i] ^ listed_by[i]) | (cond[i] ^ cond_by[i]))
         out.asymmetric += [(a.id, order[j].id) for j in _bits(lopsided)]
     ids = [r.id for r in order]
