@@ -54,6 +54,16 @@ def test_report_has_every_figure_positive_and_finite(report: dict[str, object]) 
     assert isinstance(targets, list)
     assert {(t["station"], t["figure"]) for t in targets} >= {("jiaopei", "realtime_factor"),
                                                               ("hub20", "table_build_s")}
+    # issue 13's trains ratio is judged where SUMO ran beside the kinematic engine, and only there
+    trains = report["trains"]
+    assert isinstance(trains, dict)
+    ratio = [t for t in targets if t["figure"] == "ratio_kinematic_to_sumo"]
+    if trains["ratio_kinematic_to_sumo"] is None:
+        assert ratio == []
+    else:
+        assert ratio == [{"station": "hub20", "figure": "ratio_kinematic_to_sumo", "target": ">= 5",
+                          "value": trains["ratio_kinematic_to_sumo"],
+                          "met": trains["ratio_kinematic_to_sumo"] >= 5}]
 
 
 def test_text_format_lists_every_station(report: dict[str, object]) -> None:
