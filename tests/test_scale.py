@@ -6,12 +6,14 @@ from __future__ import annotations
 import copy
 import json
 import os
+import random
 import subprocess
 import sys
 from itertools import combinations
 from pathlib import Path
 from typing import Any
 
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -49,8 +51,8 @@ Groups = list[tuple[list[int], list[tuple[int, int]]]]
 
 def _cover_by_scanning(n: int, edges: list[tuple[int, int]], size: int) -> Groups:
     """The cover's rule, plainly: a group starts at the vertex with the most uncovered pairs (the lowest of those
-    tied), found by looking at every vertex, and grows by the candidate of the first 32 that covers the most new
-    pairs, then keeps the most within reach."""
+    tied), found by looking at every vertex, and grows by a candidate covering the most new pairs with it, counted
+    here candidate by candidate: of those tied, the first 32 are weighed by the pairs they keep within reach."""
     adj: list[set[int]] = [set() for _ in range(n)]
     for a, b in edges:
         adj[a].add(b)
@@ -61,7 +63,9 @@ def _cover_by_scanning(n: int, edges: list[tuple[int, int]], size: int) -> Group
         seed = max(range(n), key=lambda v: (len(left[v]), -v))
         group, reach, useful = [seed], set(adj[seed]), set(left[seed])
         while len(group) < size and (pool := sorted(reach & useful)):
-            best = max(pool[:32], key=lambda v: (len(left[v] & set(group)), len(left[v] & reach), -v))
+            gain = {v: len(left[v] & set(group)) for v in pool}
+            tied = [v for v in pool if gain[v] == max(gain.values())]
+            best = max(tied[:32], key=lambda v: (len(left[v] & reach), -v))
             group.append(best)
             reach &= adj[best]
             useful |= left[best]
@@ -80,6 +84,19 @@ def _cover_by_scanning(n: int, edges: list[tuple[int, int]], size: int) -> Group
 def test_the_cover_follows_its_rule(graph: tuple[int, set[tuple[int, int]]], size: int) -> None:
     n, edges = graph
     assert cover(n, sorted(edges), max_size=size) == _cover_by_scanning(n, sorted(edges), size)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_the_cover_follows_its_rule_on_dense_graphs(seed: int) -> None:
+    """Dense graphs, as a hub's compatibility graph is: groups grow large, so candidates differ in the new pairs they
+    cover (counted in several bit planes) and more than 32 of them may tie."""
+    rng = random.Random(seed)
+    n = rng.randint(50, 90)
+    density = rng.choice([0.6, 0.8, 0.9])
+    edges = [(a, b) for a, b in combinations(range(n), 2) if rng.random() < density]
+    groups = cover(n, edges, max_size=40)
+    assert groups == _cover_by_scanning(n, edges, 40)
+    assert max(len(g) for g, _ in groups) >= 8
 
 
 def test_batches_are_ordered_to_move_the_fewest_turnouts_next() -> None:

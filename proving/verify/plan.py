@@ -25,7 +25,7 @@ from .probe import Failure
 
 MAX_BATCH = 40  # routes set together at most: their turnout moves queue (a few at a time), so time grows with it
 CHAIN = 32  # batches one after the other on one simulation (each cancelled before the next is set)
-_LOOK = 32  # candidates weighed for each place in a batch (more: fewer batches, longer planning)
+_LOOK = 32  # of the candidates tied on new pairs, those weighed by what they keep within reach
 
 
 Batch = tuple[tuple[str, ...], tuple[tuple[str, str], ...]]  # (routes set together, the pairs they prove)
@@ -190,9 +190,9 @@ def cover(n: int, edges: Iterable[tuple[int, int]], max_size: int = MAX_BATCH
           ) -> list[tuple[list[int], list[tuple[int, int]]]]:
     """Groups of pairwise-adjacent vertices (cliques) of the graph on ``range(n)`` with ``edges`` until every edge
     lies in a group; each group comes with the edges it is the first to cover. Greedy and deterministic: a group
-    starts at the vertex with the most uncovered edges and grows by the candidate (of the first few that would cover
-    something new) that keeps the most uncovered edges within reach. Adjacency is kept as Python integers used as
-    bit sets."""
+    starts at the vertex with the most uncovered edges and grows by the candidate that covers the most new edges with
+    it; of the candidates tied on that, the first few are weighed by the uncovered edges they keep within reach.
+    Adjacency is kept as Python integers used as bit sets."""
     adj = [0] * n
     for a, b in edges:
         adj[a] |= 1 << b
@@ -212,17 +212,19 @@ def cover_adjacent(adj: list[int], max_size: int = MAX_BATCH) -> list[tuple[list
         group, members = [seed], 1 << seed
         reach = adj[seed]  # vertices adjacent to every member
         useful = left[seed]  # vertices with an uncovered edge to some member
+        counts = [left[seed]]  # each vertex's uncovered edges to the members (kept within reach), in bit planes
         while len(group) < max_size:
             pool = reach & useful
             if not pool:
                 break
-            # the candidate covering the most new pairs with the group, then keeping the most within reach
-            best = max(_first_bits(pool, _LOOK), key=lambda v: ((left[v] & members).bit_count(),
-                                                              (left[v] & reach).bit_count(), -v))
+            # of the candidates covering the most new pairs with the group, the one keeping the most within reach
+            best = max(_first_bits(_most_counted(counts, pool), _LOOK),
+                       key=lambda v: ((left[v] & reach).bit_count(), -v))
             group.append(best)
             members |= 1 << best
             reach &= adj[best]
             useful |= left[best]
+            _count_in(counts, left[best] & reach)
         proved: list[tuple[int, int]] = []
         for v in group:
             new = left[v] & members
@@ -231,6 +233,30 @@ def cover_adjacent(adj: list[int], max_size: int = MAX_BATCH) -> list[tuple[list
         remaining -= len(proved)
         groups.append((sorted(group), sorted(proved)))
     return groups
+
+
+def _count_in(planes: list[int], s: int) -> None:
+    """Add one to the count of every vertex in the bit set ``s``. The counts are kept in bit planes (``planes[j]`` holds
+    bit ``j`` of every vertex's count), so adding a set is a binary addition done on all vertices at once: a few
+    integer operations instead of one a vertex."""
+    carry = s
+    for j, plane in enumerate(planes):
+        planes[j] = plane ^ carry
+        carry &= plane
+        if not carry:
+            return
+    planes.append(carry)
+
+
+def _most_counted(planes: list[int], pool: int) -> int:
+    """The vertices of ``pool`` with the highest count in ``planes``: from the highest bit down, those that have it
+    whenever some do."""
+    best = pool
+    for plane in reversed(planes):
+        have = best & plane
+        if have:
+            best = have
+    return best
 
 
 def _most_left(heap: list[tuple[int, int]], left: list[int]) -> int:
