@@ -64,7 +64,8 @@ def _cover_by_scanning(n: int, edges: list[tuple[int, int]], size: int) -> Group
         group, reach, useful = [seed], set(adj[seed]), set(left[seed])
         while len(group) < size and (pool := sorted(reach & useful)):
             gain = {v: len(left[v] & set(group)) for v in pool}
-            tied = [v for v in pool if gain[v] == max(gain.values())]
+            most = max(gain.values())
+            tied = [v for v in pool if gain[v] == most]
             best = max(tied[:32], key=lambda v: (len(left[v] & reach), -v))
             group.append(best)
             reach &= adj[best]
