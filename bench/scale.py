@@ -1,7 +1,9 @@
 """``liansuo bench --scale``: the figures of scale, on generated hubs (issue 13, docs/benchmark.md).
 
-* ``verify_hub{N}_s``: the whole interlocking test (every route, every pair) of an N-turnout hub, with the number of
-  Dask workers it ran on (``verify_hub{N}_workers``; 0 = in this process, with no cluster); its checks and verdict;
+* ``verify_hub{N}_s``: the whole interlocking test (every route, every pair) of an N-turnout hub, as ``liansuo
+  verify`` runs it (the compatible pairs apart proven without a simulation, docs/verify.md), with the number of Dask
+  workers it ran on (``verify_hub{N}_workers``; 0 = in this process, with no cluster); its checks, its compatible
+  pairs and those apart, and its verdict;
 * ``verify_speedup``: the same hub verified on a local cluster of 1 and of 2 workers, the ratio of the times, and
   whether the two reports are identical (they must be);
 * ``table_hub{N}_peak_mb``: peak resident memory of ``liansuo table HUB --format json -o FILE`` (a child process, so
@@ -58,6 +60,7 @@ def measure_scale(sizes: ScaleSizes) -> dict[str, Any]:
         out[f"verify_hub{turnouts}_s"] = round(seconds, 1)
         out[f"verify_hub{turnouts}_workers"] = workers
         out[f"verify_hub{turnouts}"] = {"routes": rep.routes, "pairs": rep.pairs_tested, "checks": rep.checks,
+                                        "compatible": rep.pairs_compatible, "apart": rep.pairs_apart,
                                         "failures": len(rep.failures), "ok": rep.ok}
     one, t1 = _verify(sizes.speedup_turnouts, 1)
     two, t2 = _verify(sizes.speedup_turnouts, 2)

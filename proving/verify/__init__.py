@@ -1,7 +1,8 @@
 """``liansuo verify``: the automatic interlocking test (联锁试验) of a whole station.
 
 Every route of the table goes through the items of a real test record (:mod:`.routes`, :mod:`.release`), every
-pair of routes is tried together (:mod:`.pairs`), the station data is checked against the topology and the design
+pair of routes is tried together (:mod:`.pairs`) unless the two are compatible and apart (:mod:`.apart`), the station
+data is checked against the topology and the design
 rules (:mod:`.data`), and the throats' guide total lock is tried. Each dynamic check runs on a fresh simulation
 driven only through the command language, so every failure comes with the script that shows it.
 """
@@ -12,7 +13,7 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from liansuo.interlocking.table import InterlockingTable
+from liansuo.interlocking.table import InterlockingTable, Route
 from liansuo.rules import RuleSet, load_rules
 from liansuo.stations.fit import fit_all, plural
 from liansuo.stations.loader import load
@@ -20,9 +21,10 @@ from liansuo.stations.station import Station
 
 from ..oracle.pairs import PaperOracle
 from ..progress import progress
-from .against import approach_extent, pair_conflicts, route_demands
+from .against import approach_extent, pair_conflicts, route_demands, spec
+from .apart import near_masks, table_reach
 from .data import check_station
-from .plan import UnitResult, merge, plan
+from .plan import Unit, UnitResult, again, merge, plan
 from .probe import Failure, FirstFailure
 from .routecheck import RouteResult
 from .units import Bench, frozen, run_here, spread_units
@@ -44,6 +46,8 @@ class VerifyReport:
     table: InterlockingTable | None = None
     elapsed_s: float = 0.0
     strict: bool = False
+    pairs_apart: int = 0  # compatible pairs proven apart (.apart), not simulated
+    simulate_all: bool = False  # every compatible pair simulated, those apart too
 
     @property
     def ok(self) -> bool:
@@ -58,6 +62,8 @@ class VerifyReport:
             "pairs_tested": self.pairs_tested,
             "pairs_conflicting": self.pairs_conflicting,
             "pairs_compatible": self.pairs_compatible,
+            "pairs_apart": self.pairs_apart,
+            "simulate_all_pairs": self.simulate_all,
             "checks": self.checks,
             "failures": [f.as_dict() for f in self.failures],
             "warnings": [f.as_dict() for f in self.warnings],
@@ -71,11 +77,13 @@ class VerifyReport:
 def verify_station(station: str | Path | Station, *, routes: list[str] | None = None, pairs: bool = True,
                    strict: bool = False, rules: RuleSet | None = None, cycle_s: float = 0.25,
                    stop_at_first: bool = False, workers: int = 0, scheduler: str | None = None,
-                   show_progress: bool | None = False) -> VerifyReport:
+                   show_progress: bool | None = False, simulate_all: bool = False) -> VerifyReport:
     """Run the whole interlocking test; ``routes`` limits route and pair checks to those routes. The table is held
     against the oracle first (quick), then every unit of the dynamic test (:mod:`.plan`) runs: here, one after the
     other (``workers`` 0), or fanned out on Dask over ``workers`` local processes or the cluster at ``scheduler``
     (:mod:`proving.spread`). The report is the same either way.
+    Compatible pairs of routes apart (:mod:`.apart`) are proven without a simulation unless ``simulate_all``; those
+    of a route that failed on its own are simulated after the other units.
     ``stop_at_first``: stop at the first failure (the mutation run only needs to know that one was found; here only).
     ``show_progress``: a bar on stderr (None: when it is a terminal)."""
     t0 = time.perf_counter()
@@ -85,30 +93,43 @@ def verify_station(station: str | Path | Station, *, routes: list[str] | None = 
     table = bench.table
     ctx = bench.context(stop_at_first)
     focus = set(routes) if routes else None
+    order = list(table.routes.values())
     results: list[UnitResult] = []
+
+    def run(units: list[Unit], what: str) -> list[UnitResult]:
+        with progress(what, len(units), show=show_progress) as advance:
+            if workers and not stop_at_first:
+                return spread_units(bench, units, workers, scheduler, advance)
+            return list(run_here(bench, units, stop_at_first=stop_at_first, done=advance))
+
     with frozen():  # before planning too: on a hub the plan makes millions of objects, the table is millions more
-        work = plan(table, focus, pairs=pairs)
+        oracle = PaperOracle(st, ctx.rules)
+        prints = [oracle.footprint(spec(r)) for r in order] if pairs else []
+        near = None if simulate_all or not pairs else near_routes(st, order, prints, focus)
+        work = plan(table, focus, pairs=pairs, near=near)
+        apart = work.pairs_apart
         try:
             if focus:
                 for rid in sorted(focus - set(table.routes)):
                     ctx.record(False, "route", rid, f"there is no route {rid}; see 'liansuo table {st.id}'")
-            oracle = PaperOracle(st, ctx.rules)
-            for r in table.routes.values():
+            for r in order:
                 if not focus or r.id in focus:
                     route_demands(ctx, oracle, r)
             if pairs:
-                pair_conflicts(ctx, oracle, focus)
+                pair_conflicts(ctx, oracle, focus, prints)
                 for a, b in work.asymmetric:
                     ctx.record(False, "conflict-symmetry", f"{a} + {b}", "the table lists the conflict on one route "
                                "only")
             if not focus:
                 approach_extent(ctx)
             check_station(ctx, focus)
-            with progress(f"verify {st.id}", len(work.units), show=show_progress) as advance:
-                if workers and not stop_at_first:
-                    results = spread_units(bench, work.units, workers, scheduler, advance)
-                else:
-                    results = list(run_here(bench, work.units, stop_at_first=stop_at_first, done=advance))
+            results = run(work.units, f"verify {st.id}")
+            failed = {r.route.id for r in results if isinstance(r.route, RouteResult) and r.route.failures}
+            if apart and failed and not stop_at_first:
+                units, moved = again(work, order, failed)
+                apart -= moved
+                results += run(units, f"verify {st.id}: pairs of routes that failed on their own")
+            ctx.checks += apart  # each pair apart proven (see .apart): a check as a simulation of it would be
         except FirstFailure:  # in the checks against the oracle (the units stop by themselves)
             pass
     checks, failures, warnings = merge([UnitResult(ctx.checks, ctx.failures, ctx.warnings), *results])
@@ -116,7 +137,19 @@ def verify_station(station: str | Path | Station, *, routes: list[str] | None = 
                         sum(1 for u in work.units if u.kind == "route"), work.pairs_tested, work.pairs_conflicting,
                         work.pairs_compatible, checks, failures, warnings,
                         [r.route for r in results if isinstance(r.route, RouteResult)], table,
-                        time.perf_counter() - t0, strict)
+                        time.perf_counter() - t0, strict, apart, simulate_all)
+
+
+def near_routes(st: Station, order: list[Route], prints: list[frozenset[str]], focus: set[str] | None
+                ) -> list[int]:
+    """Which routes are near which (:mod:`.apart`), as bit sets in table order. With a ``focus``, the routes outside
+    it have no route unit of their own to stand on: they count as near every route."""
+    near = near_masks([table_reach(st, r) | fp for r, fp in zip(order, prints, strict=True)])
+    if focus:
+        everyone = (1 << len(order)) - 1
+        outside = sum(1 << k for k, r in enumerate(order) if r.id not in focus)
+        near = [everyone if outside >> k & 1 else m | outside for k, m in enumerate(near)]
+    return near
 
 
 def report_text(rep: VerifyReport, *, verbose: bool = False) -> str:
@@ -130,7 +163,8 @@ def report_text(rep: VerifyReport, *, verbose: bool = False) -> str:
         lines.append(f"  {res.id:16} {status:7} {res.checks:4} checks   aspects {'/'.join(shown) or '-':10} of "
                      f"{'/'.join(table)}")
     lines.append(f"pairs     {rep.pairs_tested} tested: {rep.pairs_conflicting} conflicting (each refused after the "
-                 f"other, both ways), {rep.pairs_compatible} compatible (both set and open)")
+                 f"other, both ways), {rep.pairs_compatible} compatible (both set and open"
+                 + (f"; {rep.pairs_apart} of them apart, proven without a simulation)" if rep.pairs_apart else ")"))
     for w in rep.warnings:
         lines.append(f"WARN {w.check} {w.subject}: {w.detail}")
     for f in rep.failures:

@@ -95,14 +95,17 @@ def approach_extent(ctx: Context) -> None:
                            f"{sig.id}, but the route's approach is {', '.join(r.approach) or 'empty'}")
 
 
-def pair_conflicts(ctx: Context, oracle: PaperOracle, focus: set[str] | None) -> tuple[int, int]:
+def pair_conflicts(ctx: Context, oracle: PaperOracle, focus: set[str] | None,
+                   prints: list[frozenset[str]] | None = None) -> tuple[int, int]:
     """Every pair of routes from different signals; returns (pairs judged, pairs the oracle keeps apart). Pairs whose
-    footprints (:meth:`PaperOracle.footprint`) share nothing are judged compatible without tracing them together."""
+    footprints (:meth:`PaperOracle.footprint`; ``prints``, in table order, if already found) share nothing are judged
+    compatible without tracing them together."""
     routes = list(ctx.table.routes.values())
     # the enemies the station file adds are the designer's word, not the oracle's to judge: the pair tests check that
     # the interlocking keeps them apart
     added = {frozenset((e.route, e.enemy)) for e in ctx.station.model.overrides.enemies}
-    prints = [oracle.footprint(spec(r)) for r in routes]
+    if prints is None:
+        prints = [oracle.footprint(spec(r)) for r in routes]
     holders: dict[str, set[int]] = {}
     for i, fp in enumerate(prints):
         for element in fp:

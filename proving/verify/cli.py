@@ -1,5 +1,5 @@
-"""``liansuo verify STATION [--format text|json] [--strict] [--route ID ...] [--no-pairs] [-v] [--workers N]
-[--scheduler ADDRESS]``."""
+"""``liansuo verify STATION [--format text|json] [--strict] [--route ID ...] [--no-pairs] [--simulate-all-pairs] [-v]
+[--workers N] [--scheduler ADDRESS]``."""
 
 from __future__ import annotations
 
@@ -23,7 +23,7 @@ def cmd_verify(args: argparse.Namespace) -> int:
     try:
         rep = verify_station(args.station, routes=args.route, pairs=not args.no_pairs, strict=args.strict,
                              workers=args.workers or (1 if args.scheduler else 0), scheduler=args.scheduler,
-                             show_progress=None)
+                             show_progress=None, simulate_all=args.simulate_all_pairs)
     except StationError as exc:
         return bad_input(exc)
     except SpreadError as exc:
@@ -50,6 +50,9 @@ def register(add: Add) -> None:
     sp.add_argument("--strict", action="store_true", help="design-rule warnings (dead zones ...) fail too")
     sp.add_argument("--route", action="append", metavar="ID", help="test only this route and its pairs (repeatable)")
     sp.add_argument("--no-pairs", action="store_true", help="skip the pairs of routes")
+    sp.add_argument("--simulate-all-pairs", action="store_true",
+                    help="set and open together every compatible pair, also those apart (sharing no element), which "
+                    "are otherwise proven without a simulation; slower on a large station (docs/verify.md)")
     sp.add_argument("-v", "--verbose", action="store_true", help="print the steps that reproduce each failure")
     sp.add_argument("--workers", type=count, default=0, metavar="N",
                     help="fan the test out on Dask over N local worker processes (default: run here, in one)")

@@ -11,6 +11,10 @@ compatible (cliques of the compatibility graph) until every compatible pair lies
 routes together and seeing every signal open proves each of its pairs; a group that does not open is tried again
 pair by pair, so a failure still comes with the script of just its two routes. Batches run in chains on one
 simulation, each cancelled before the next is set: the turnouts the next needs often lie right already.
+
+Given which routes are near one another (:mod:`.apart`), only the compatible pairs of near routes must lie in a
+group; the groups are still cliques of the whole compatibility graph, so a group may hold routes far apart too. The
+pairs of routes apart are counted, and simulated only for a route that failed on its own (:func:`again`).
 """
 
 from __future__ import annotations
@@ -50,30 +54,36 @@ class Plan:
     pairs_tested: int = 0
     pairs_conflicting: int = 0
     pairs_compatible: int = 0
+    pairs_apart: int = 0  # compatible pairs proven apart (.apart), not simulated
     asymmetric: list[tuple[str, str]] = field(default_factory=list)  # conflicts listed on one route only
+    ids: list[str] = field(default_factory=list)  # the routes in table order: bit j of the sets below is ids[j]
+    compatible: list[int] = field(default_factory=list)  # each route's compatible partners (of the focus)
+    apart: list[int] = field(default_factory=list)  # of those, the partners it is apart from
 
 
 STATION_ITEMS = ("throats", "power-up", "red-lamp-transfer")
 
 
-def plan(table: InterlockingTable, focus: set[str] | None, *, pairs: bool) -> Plan:
-    """Every unit of the test of ``table``, in report order (see the module docstring)."""
+def plan(table: InterlockingTable, focus: set[str] | None, *, pairs: bool, near: list[int] | None = None) -> Plan:
+    """Every unit of the test of ``table``, in report order (see the module docstring). ``near``: for each route of
+    the table, in its order, the routes near it as a bit set (:func:`.apart.near_masks`); None: every compatible pair
+    is simulated."""
     order = list(table.routes.values())
     units = [Unit("route", (r.id,)) for r in order if not focus or r.id in focus]
     out = Plan([])
     if pairs:
-        out = _pairs(order, focus)
+        out = _pairs(order, focus, near)
     out.units[:0] = units
     if not focus:
         out.units += [Unit("station", item=item) for item in STATION_ITEMS]
     return out
 
 
-def _pairs(order: list[Route], focus: set[str] | None) -> Plan:
-    """The pair units of ``order``: each route's enemies, the chains of batches of compatible routes, each
-    conditional pair. Who conflicts with whom is kept as bit sets (Python integers, bit ``j`` for ``order[j]``), so a
-    hub's millions of pairs are sorted in a few operations a route instead of a test a pair; the units and counts are
-    those of a test a pair (tests/test_scale.py holds them to it)."""
+def _pairs(order: list[Route], focus: set[str] | None, near: list[int] | None) -> Plan:
+    """The pair units of ``order``: each route's enemies, the chains of batches of compatible routes near each other
+    (all of them when ``near`` is None), each conditional pair. Who conflicts with whom is kept as bit sets (Python
+    integers, bit ``j`` for ``order[j]``), so a hub's millions of pairs are sorted in a few operations a route instead
+    of a test a pair; the units and counts are those of a test a pair (tests/test_scale.py holds them to it)."""
     n = len(order)
     index = {r.id: k for k, r in enumerate(order)}
     listed = _masks(order, index, lambda r: r.conflicts)  # b in a.conflicts
@@ -109,13 +119,29 @@ def _pairs(order: list[Route], focus: set[str] | None) -> Plan:
         out.pairs_compatible += (adj[i] & later).bit_count()
         lopsided = later & ((listed[i] ^ listed_by[i]) | (cond[i] ^ cond_by[i]))
         out.asymmetric += [(a.id, order[j].id) for j in _bits(lopsided)]
+    apart = [0] * n if near is None else [x & ~near[i] for i, x in enumerate(adj)]
+    out.pairs_apart = sum(x.bit_count() for x in apart) // 2
+    out.ids, out.compatible, out.apart = [r.id for r in order], adj, apart
+    need = adj if near is None else [x & near[i] for i, x in enumerate(adj)]
+    out.units = rivals + _chains(order, adj, need) + conditionals
+    return out
+
+
+def again(p: Plan, order: list[Route], failed: set[str]) -> tuple[list[Unit], int]:
+    """The chains of batches that simulate every pair apart with a route in ``failed`` (a route that failed on its
+    own: the argument for its pairs apart does not hold), and how many pairs they are."""
+    bad = sum(1 << k for k, r in enumerate(p.ids) if r in failed)
+    need = [x if bad >> i & 1 else x & bad for i, x in enumerate(p.apart)]
+    return _chains(order, p.compatible, need), sum(x.bit_count() for x in need) // 2
+
+
+def _chains(order: list[Route], adj: list[int], need: list[int]) -> list[Unit]:
+    """Chains of batches: cliques of ``adj`` covering every edge of ``need``, in an order that moves few turnouts."""
     ids = [r.id for r in order]
     batches: list[Batch] = [(tuple(ids[k] for k in group), tuple((ids[x], ids[y]) for x, y in proved))
-                            for group, proved in cover_adjacent(adj)]
+                            for group, proved in cover_adjacent(adj, need=need)]
     batches = by_turnouts(batches, {r.id: r for r in order})
-    chains = [Unit("batches", batches=tuple(batches[i:i + CHAIN])) for i in range(0, len(batches), CHAIN)]
-    out.units = rivals + chains + conditionals
-    return out
+    return [Unit("batches", batches=tuple(batches[i:i + CHAIN])) for i in range(0, len(batches), CHAIN)]
 
 
 def _masks(order: list[Route], index: dict[str, int], named: Callable[[Route], Iterable[str]]) -> list[int]:
@@ -200,9 +226,11 @@ def cover(n: int, edges: Iterable[tuple[int, int]], max_size: int = MAX_BATCH
     return cover_adjacent(adj, max_size)
 
 
-def cover_adjacent(adj: list[int], max_size: int = MAX_BATCH) -> list[tuple[list[int], list[tuple[int, int]]]]:
-    """:func:`cover` of the graph whose vertex ``v`` is adjacent to the bits of ``adj[v]``."""
-    left = list(adj)  # uncovered edges at each vertex
+def cover_adjacent(adj: list[int], max_size: int = MAX_BATCH, need: list[int] | None = None
+                   ) -> list[tuple[list[int], list[tuple[int, int]]]]:
+    """:func:`cover` of the graph whose vertex ``v`` is adjacent to the bits of ``adj[v]``; with ``need`` (a part of
+    ``adj``, symmetric as it is), groups are still cliques of ``adj`` but only the edges of ``need`` must be covered."""
+    left = list(adj if need is None else need)  # uncovered edges at each vertex
     remaining = sum(x.bit_count() for x in left) // 2
     heap = [(-x.bit_count(), v) for v, x in enumerate(left)]  # counts only fall: stale entries are pushed again
     heapq.heapify(heap)
