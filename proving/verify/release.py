@@ -8,7 +8,7 @@ from functools import partial
 
 from liansuo.interlocking.aspects import is_open
 from liansuo.interlocking.table import Route
-from liansuo.stations.schema import SignalKind
+from liansuo.stations.schema import Link, SignalKind
 
 from .probe import Context, Failure, Probe, against_running, open_route, other, route_line
 from .routecheck import RouteCheck
@@ -356,7 +356,7 @@ class ReleaseChecks:
             self.seen(p)
             if p.aspect(r.signal) in self.ctx.rules.aspects.flashing:
                 self.flasher(p)
-            if o.category == "departure":
+            if o.category == "departure" and self._automatic(o.exit_link):
                 p = Probe(self.ctx)
                 if open_route(p, r, o):
                     self.vary_blocks(p, o.exit_link, o)
@@ -372,8 +372,8 @@ class ReleaseChecks:
     def vary_blocks(self, p: Probe, link_id: str | None, departure: Route) -> None:
         """Occupy the third, then the second block section beyond a departure: the departure signal shows LU, then U
         (four-aspect automatic block); the route under test follows."""
-        link = next((lk for lk in self.st.model.links if lk.id == link_id), None)
-        if link is None or link.kind.value != "automatic":
+        link = self._automatic(link_id)
+        if link is None:
             return
         signal = departure.signal
         if against_running(self.st, link.id):
@@ -392,6 +392,11 @@ class ReleaseChecks:
             want = self.ctx.rules.aspects.automatic_block[n]
             self.rt.check(p.aspect(signal) == want, "aspect", f"{n} clear block section(s) beyond {signal}: it "
                           f"shows {p.aspect(signal)}, expected {want}", p)
+
+    def _automatic(self, link_id: str | None) -> Link | None:
+        """The link ``link_id`` if it is worked by automatic block (its block sections can be varied), else None."""
+        link = next((lk for lk in self.st.model.links if lk.id == link_id), None)
+        return link if link is not None and link.kind.value == "automatic" else None
 
     def flasher(self, p: Probe) -> None:
         r = self.r
