@@ -10,6 +10,7 @@ driven only through the command language, so every failure comes with the script
 from __future__ import annotations
 
 import time
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -108,7 +109,8 @@ def verify_station(station: str | Path | Station, *, routes: list[str] | None = 
         near = None if simulate_all or not pairs else near_routes(st, order, prints, focus)
         work = plan(table, focus, pairs=pairs, near=near)
         apart = work.pairs_apart
-        try:
+
+        def table_checks() -> None:
             if focus:
                 for rid in sorted(focus - set(table.routes)):
                     ctx.record(False, "route", rid, f"there is no route {rid}; see 'liansuo table {st.id}'")
@@ -123,7 +125,18 @@ def verify_station(station: str | Path | Station, *, routes: list[str] | None = 
             if not focus:
                 approach_extent(ctx)
             check_station(ctx, focus)
-            results = run(work.units, f"verify {st.id}")
+
+        try:
+            if workers and not stop_at_first:
+                # the table is held against the oracle here while the workers run the units (on a hub it takes
+                # half a minute, which a core would otherwise spend waiting); only this thread writes to ctx
+                with ThreadPoolExecutor(1) as pool:
+                    checked = pool.submit(table_checks)
+                    results = run(work.units, f"verify {st.id}")
+                    checked.result()
+            else:
+                table_checks()
+                results = run(work.units, f"verify {st.id}")
             failed = {r.route.id for r in results if isinstance(r.route, RouteResult) and r.route.failures}
             if apart and failed and not stop_at_first:
                 units, moved = again(work, order, failed)
