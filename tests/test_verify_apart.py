@@ -9,6 +9,8 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as hs
 
 from liansuo.cli.main import main
 from liansuo.interlocking.core import Core
@@ -20,7 +22,7 @@ from liansuo.proving.oracle.pairs import PaperOracle
 from liansuo.proving.verify import near_routes, verify_station
 from liansuo.proving.verify.against import spec
 from liansuo.proving.verify.apart import table_reach
-from liansuo.proving.verify.plan import plan
+from liansuo.proving.verify.plan import cover_adjacent, plan
 from liansuo.rules import load_rules
 from liansuo.stations.station import Station
 
@@ -53,8 +55,9 @@ def _row_names(st: Station, table: InterlockingTable) -> dict[str, set[str]]:
     for r in table.routes.values():
         names = set(_names(r.as_dict()))
         for t in list(names):
-            if t in st.turnouts and st.turnouts[t].pair:
-                names |= set(st.pairs[st.turnouts[t].pair])
+            pair = st.turnouts[t].pair if t in st.turnouts else None
+            if pair:
+                names |= set(st.pairs[pair])
         out[r.id] = names
     return out
 
@@ -78,6 +81,30 @@ def unsimulated_sharing(st: Station) -> list[tuple[str, str]]:
             if meet and work.compatible[i] >> j & 1 and frozenset((a.id, b.id)) not in simulated:
                 wrong.append((a.id, b.id))
     return wrong
+
+
+@settings(max_examples=80, deadline=None)
+@given(hs.integers(2, 14).flatmap(lambda n: hs.tuples(hs.just(n), hs.sets(hs.tuples(
+    hs.integers(0, n - 1), hs.integers(0, n - 1), hs.booleans()).filter(lambda e: e[0] < e[1])))),
+    hs.integers(2, 6))
+def test_the_cover_of_some_pairs_proves_each_once_in_groups_of_compatible_routes(
+        graph: tuple[int, set[tuple[int, int, bool]]], size: int) -> None:
+    n, edges = graph
+    adj, need = [0] * n, [0] * n
+    wanted = set()
+    for a, b, needed in edges:
+        adj[a] |= 1 << b
+        adj[b] |= 1 << a
+        if needed:
+            need[a] |= 1 << b
+            need[b] |= 1 << a
+            wanted.add((a, b))
+    groups = cover_adjacent(adj, max_size=size, need=need)
+    proved = [e for _, new in groups for e in new]
+    assert sorted(proved) == sorted(wanted)  # every pair needed, once, and no other
+    for group, _ in groups:
+        assert len(group) <= size
+        assert all(adj[a] >> b & 1 for i, a in enumerate(group) for b in group[i + 1:])  # pairwise compatible
 
 
 @pytest.mark.parametrize("name", STATIONS)
