@@ -7,7 +7,8 @@ on the signal ahead for the aspect (``interlocking/core.py``). So two compatible
 
 - their rows of the interlocking table name no element in common (:func:`table_reach`: buttons, signals, the signal
   ahead, turnouts with their crossover partners, sections with the fouling, overlap, approach, run-on and line
-  sections, the section beyond the end, the track led into, diamonds, block link), and
+  sections, the track led into, diamonds, block link; not the section beyond the end, which the interlocking reads
+  only for its occupancy as a train releases the route, and which no route set or opened changes), and
 - the oracle's footprints do not meet either (``PaperOracle.footprint``: every element the safety of either route
   turns on, derived from the track geometry, not from the table);
 
