@@ -14,6 +14,7 @@ from hypothesis import strategies as hs
 
 from liansuo.cli.main import main
 from liansuo.interlocking.core import Core
+from liansuo.interlocking.operations import Operator
 from liansuo.interlocking.table import InterlockingTable, build_table
 from liansuo.proving import verify as verify_module
 from liansuo.proving.mutants import MUTANTS
@@ -188,3 +189,28 @@ def test_the_report_says_how_many_pairs_were_proven_apart(capsys: pytest.Capture
     assert main(["verify", "jiaopei", "--simulate-all-pairs"]) == 0
     out = capsys.readouterr().out
     assert "apart" not in out and out.strip().splitlines()[-1].startswith("PASS: 2703 checks")
+
+
+def test_a_coupling_through_no_shared_element_is_found_only_when_every_pair_is_simulated(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """The limit docs/verify.md states, made visible: an interlocking that refuses one route while another it shares
+    nothing with is set passes the argument of .apart, and fails once every compatible pair is simulated."""
+    st = load_station("jiaopei")
+    table = build_table(st)
+    order = list(table.routes.values())
+    oracle = PaperOracle(st, load_rules())
+    work = plan(table, None, pairs=True, near=near_routes(st, order, [oracle.footprint(spec(r)) for r in order],
+                                                          None))
+    i = next(k for k, m in enumerate(work.apart) if m)
+    a, b = work.ids[i], work.ids[(work.apart[i] & -work.apart[i]).bit_length() - 1]
+    was = Operator.route_blocker
+
+    def route_blocker(self: Operator, r: Any, run_on: Any = None) -> str:
+        coupled = {a: b, b: a}.get(r.id)
+        return "a seeded coupling" if coupled in self.il.routes else was(self, r, run_on)
+
+    monkeypatch.setattr(Operator, "route_blocker", route_blocker)
+    assert verify_station("jiaopei").ok  # proven apart: the defect goes unseen, as the docs say
+    full = verify_station("jiaopei", simulate_all=True)
+    assert [f.subject for f in full.failures if f.check == "compatible"] == [f"{a} + {b}"]
+    assert not full.ok
