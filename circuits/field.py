@@ -211,13 +211,7 @@ class Field:
                 self._moving.discard(t_id)
             if (m.dbj, m.fbj) != was:
                 self._changes.turnouts.add(t_id)
-        for sig in cmd.changed_signals:
-            self._relight(sig, cmd.lamps.get(sig, set()))
-            fl = self.flashers.get(sig)
-            if fl is not None and fl.energised != (sig in cmd.flashing):
-                fl.energise(sig in cmd.flashing)
-                self._changes.signals.add(sig)
-        cmd.changed_signals.clear()
+        self.light(cmd)
         for sig, fl in self.flashers.items():
             if fl.energised:
                 healthy = fl.healthy
@@ -241,6 +235,18 @@ class Field:
         self.t += dt
         for sec in self.flicker.since:
             self._flick(sec)
+
+    def light(self, commands: FieldCommands) -> None:
+        """Light the lamps and energise the flashers of the signals whose commands changed, at once (lamps take no
+        time to light)."""
+        cmd = commands
+        for sig in cmd.changed_signals:
+            self._relight(sig, cmd.lamps.get(sig, set()))
+            fl = self.flashers.get(sig)
+            if fl is not None and fl.energised != (sig in cmd.flashing):
+                fl.energise(sig in cmd.flashing)
+                self._changes.signals.add(sig)
+        cmd.changed_signals.clear()
 
     def rest_steps(self, dt: float, commands: FieldCommands, limit: int) -> int:
         """How many of the next steps (at most ``limit``) would do nothing but run on the switch machines already
@@ -277,9 +283,9 @@ class Field:
             self.t += dt
 
     def _relight(self, signal: str, lit: set[str]) -> None:
-        before = self.lamps[signal].proving()
-        self.lamps[signal].apply(lit)
-        if self.lamps[signal].proving() != before:
+        lamps = self.lamps[signal]
+        before = lamps.proving()
+        if lamps.apply(lit) != before:
             self._changes.signals.add(signal)
 
     # ---- relays the interlocking reads ------------------------------------------------------------------------

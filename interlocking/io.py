@@ -85,6 +85,22 @@ class RelayBoard:
     def pulse(self, link: str, message: str) -> None:
         self.line_in.setdefault(link, set()).add(message)
 
+    def copy(self) -> RelayBoard:
+        """A board of its own with the same relays and the same changes waiting to be taken."""
+        other = RelayBoard()
+        other.load(self)
+        return other
+
+    def load(self, other: RelayBoard) -> None:
+        """Take ``other``'s relays and waiting changes, copied (``other`` is left as it is)."""
+        self.track, self.dbj, self.fbj = dict(other.track), dict(other.dbj), dict(other.fbj)
+        self.lamps = {sig: dict(lamps) for sig, lamps in other.lamps.items()}
+        self.flasher, self.filament_alarm = dict(other.flasher), dict(other.filament_alarm)
+        self.pdkj, self.pdqcj = dict(other.pdkj), dict(other.pdqcj)
+        self.line_in = {link: set(msgs) for link, msgs in other.line_in.items()}
+        self.changed_tracks, self.changed_turnouts = set(other.changed_tracks), set(other.changed_turnouts)
+        self.changed_signals, self.changed_doors = set(other.changed_signals), set(other.changed_doors)
+
     # ---- read by the interlocking (fail-safe defaults) ------------------------------------------------------
     def clear(self, section: str) -> bool:
         return self.track.get(section, False)

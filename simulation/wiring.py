@@ -19,7 +19,25 @@ class Wiring:
         self.field = field
         self.commands = FieldCommands()
         self.signal_lamps = station.derived(_signal_lamps)  # read only: shared by every wiring of the station
-        self._lit = False  # the first commands light every signal's lamps (the aspects set before any cycle)
+        self._lit = False  # until every signal is lit at power-on, and again once a restarted interlocking takes over
+
+    def power_on(self, board: RelayBoard, out: Outputs) -> None:
+        """The station powers on: the field, as built, lights every signal at the aspect ``out`` commands (lamps
+        take no time to light), and ``board`` reads every relay (``publish(board, everything=True)``).
+
+        A field is built the same for every simulation of a station (:func:`~circuits.field.field_plan`), and the
+        interlocking starts with the same aspects, so what the board reads then is the same for all of them: the
+        first wiring of a station reads it, and the others copy it (verify builds thousands of simulations). With
+        other aspects at power-on the board reads the field again."""
+        self.field.light(self.commands_from(out))
+        first = self.station.derived(_PoweredOn, self.rules)
+        if first.board is not None and first.aspects == out.signals:
+            self.field.take_changes()
+            board.load(first.board)
+            return
+        self.publish(board, everything=True)
+        if first.board is None:
+            first.aspects, first.board = dict(out.signals), board.copy()
 
     def relight(self) -> None:
         """Send every signal's lamps again with the next commands (a new interlocking has taken over)."""
@@ -67,6 +85,15 @@ class Wiring:
         for key in (f.doors if everything else ch.doors):
             pdkj, pdqcj = f.doors_relays(key)
             board.set_doors(key, pdkj, pdqcj)
+
+
+class _PoweredOn:
+    """What the first simulation of a station read at power-on (:meth:`Wiring.power_on`): the aspects, and the
+    relay board that read the field. Set once; never changed after."""
+
+    def __init__(self, station: Station, rules: RuleSet) -> None:
+        self.aspects: dict[str, str] = {}
+        self.board: RelayBoard | None = None
 
 
 def _signal_lamps(station: Station) -> dict[str, set[str]]:

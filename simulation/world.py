@@ -63,7 +63,7 @@ class World:
         self.fleet = Fleet(self.station, self.field, lambda: self.view.outputs.signals, self.log, self.auto_limit,
                            engine=motion, rules=self.rules)
         attach_engine(motion, self.fleet)
-        self.wiring.publish(self.view.inputs, everything=True)
+        self.wiring.power_on(self.view.inputs, self.view.outputs)
         self.interlocking.cycle(self.t)
 
     # ---- time -------------------------------------------------------------------------------------------------

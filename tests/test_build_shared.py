@@ -10,18 +10,23 @@ import gc
 import pickle
 import weakref
 from collections.abc import Callable
+from dataclasses import fields
 from itertools import zip_longest
 from pathlib import Path
 
 import pytest
 from conftest import edit
 
-from liansuo.circuits.field import field_plan
+from liansuo.circuits.field import Changes, Field, field_plan
 from liansuo.circuits.railgeometry import geometry_of
 from liansuo.circuits.trackcircuits import SectionCircuit, build_circuit
+from liansuo.interlocking.cbi import Interlocking
+from liansuo.interlocking.io import RelayBoard
+from liansuo.interlocking.table import build_table
 from liansuo.proving.oracle import Watch
 from liansuo.rules import RuleSet, load_rules
 from liansuo.simulation.sim import Simulation
+from liansuo.simulation.wiring import Wiring
 from liansuo.stations.loader import load, load_text
 from liansuo.stations.station import Station
 
@@ -161,6 +166,9 @@ def test_no_piece_a_simulation_changes_is_shared(name: str) -> None:
     def pieces(w: Watched) -> list[object]:
         fld, core = w.sim.field, w.sim.interlocking.core
         out: list[object] = [fld, core, core.board, core.out, core.locks, w.watch.oracle, w.watch.oracle.flank]
+        board = core.board  # read at power-on from the first simulation's board (``Wiring.power_on``)
+        out += [board.track, board.dbj, board.fbj, board.lamps, *board.lamps.values(), board.flasher,
+                board.filament_alarm, board.pdkj, board.pdqcj, board.changed_tracks, board.changed_signals]
         for c in fld.circuits.values():
             out += [c, c.faults, c.faults.capacitors]
             if c.counter is not None:
@@ -175,6 +183,60 @@ def test_no_piece_a_simulation_changes_is_shared(name: str) -> None:
 
     mine = {id(p) for p in pieces(a)}
     assert [p for p in pieces(b) if id(p) in mine] == []
+
+
+@pytest.mark.parametrize("name", [*STATIONS, "depot"])
+def test_power_on_reads_the_field_as_it_is_built(name: str) -> None:
+    """Every simulation's board at power-on holds what reading every relay of a field just built and lit shows, the
+    first one's (which reads the field) and the later ones' (which copy it), changes waiting included; the field's
+    changes are taken, as a reading takes them."""
+    station, rules = load(name), load_rules()
+    table = build_table(station, rules)
+
+    def powered_on() -> tuple[RelayBoard, RelayBoard]:
+        out = Interlocking(table, rules).core.out
+        wiring, board = Wiring(station, rules, Field(station, rules=rules)), RelayBoard()
+        wiring.power_on(board, out)
+        assert wiring.field.take_changes() == Changes() and wiring.field.stamp == 1
+        by_hand = Wiring(station, rules, Field(station, rules=rules))
+        by_hand.field.light(by_hand.commands_from(out))
+        read = RelayBoard()
+        by_hand.publish(read, everything=True)
+        return board, read
+
+    for _ in range(2):
+        board, read = powered_on()
+        assert board == read
+        assert set(board.track) == set(station.sections) and board.changed_tracks == set(station.sections)
+
+
+def test_a_copied_relay_board_is_its_own() -> None:
+    """``RelayBoard.copy`` copies every relay and every change waiting, and shares nothing it could change."""
+    board = RelayBoard()
+    for f in fields(RelayBoard):
+        value = getattr(board, f.name)
+        if isinstance(value, set):
+            value.add(f"{f.name}-x")
+        elif f.name == "lamps":
+            value["S"] = {"H": True}
+        elif f.name == "line_in":
+            value["L"] = {"msg"}
+        else:
+            value[f"{f.name}-x"] = True
+    copy = board.copy()
+    assert copy == board
+    for f in fields(RelayBoard):
+        value = getattr(copy, f.name)
+        assert value is not getattr(board, f.name)
+        if isinstance(value, set):
+            value.clear()
+        else:
+            for inner in value.values():
+                if isinstance(inner, (set, dict)):
+                    inner.clear()
+            value.clear()
+    assert copy != board and board.lamps == {"S": {"H": True}} and board.line_in == {"L": {"msg"}}
+    assert all(getattr(board, f.name) for f in fields(RelayBoard))
 
 
 def _short_25hz(rules: RuleSet) -> RuleSet:
