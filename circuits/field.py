@@ -3,11 +3,11 @@
 ``Field.step(dt, commands)`` moves time on: switch machines turn, doors open and close, the USU flasher flashes,
 lamps light as commanded, and track circuits follow the wheelsets standing on them (``set_axles``: loose wheelsets
 and trains, :mod:`.shunts`) and the teaching panel's switch K (``occupy`` / ``vacate``). Relay states are read
-through the ``track_up``, ``indication``, ``lamp_proven``, ``flasher_ok`` and ``doors`` methods; ``take_changes``
-says what changed since it was last called, so the one reading them copies only that. Faults are injected with
-``inject`` and removed with ``repair`` (``circuits.faults`` parses them). Traction current leaking through a long
-dead zone (``set_leakage``) makes a section's relay flicker down in a pattern driven by the field's time
-(:mod:`.leakage`).
+through the ``track_up`` (``tracks_down`` for many sections at once), ``indication``, ``lamp_proven``, ``flasher_ok``
+and ``doors`` methods; ``take_changes`` says what changed since it was last called, so the one reading them copies
+only that. Faults are injected with ``inject`` and removed with ``repair`` (``circuits.faults`` parses them).
+Traction current leaking through a long dead zone (``set_leakage``) makes a section's relay flicker down in a
+pattern driven by the field's time (:mod:`.leakage`).
 """
 
 from __future__ import annotations
@@ -113,6 +113,7 @@ class Field:
         self._driven: set[str] = set()  # machines with a drive command outstanding
         self._moving: set[str] = set()
         self.stamp = 0  # counts the batches of changes taken: what reads the field can tell when nothing changed
+        self.lamp_stamp = 0  # counts the lamp commands applied: what reads the lamps can tell when none changed
         self._changes = Changes(set(station.sections), set(station.turnouts), set(station.signals),
                                 set(self.doors))
 
@@ -284,6 +285,7 @@ class Field:
 
     def _relight(self, signal: str, lit: set[str]) -> None:
         lamps = self.lamps[signal]
+        self.lamp_stamp += 1
         before = lamps.proving()
         if lamps.apply(lit) != before:
             self._changes.signals.add(signal)
@@ -291,6 +293,11 @@ class Field:
     # ---- relays the interlocking reads ------------------------------------------------------------------------
     def track_up(self, section: str) -> bool:
         return self.circuits[section].up
+
+    def tracks_down(self, sections: Iterable[str]) -> set[str]:
+        """Those of ``sections`` whose track relay is down, read at once (what ``track_up`` says of each)."""
+        circuits = self.circuits
+        return {s for s in sections if not circuits[s].up}
 
     def indication(self, turnout: str) -> tuple[bool, bool]:
         m = self.machines[turnout]

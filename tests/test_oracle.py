@@ -258,3 +258,26 @@ def test_the_oracle_reads_the_station_not_the_table() -> None:
     a = Tracer(gaotie).trace("X", "train", {"1": "reverse", "3": "reverse", "13": "reverse", "15": "reverse",
                                            "9": "normal"}.get)
     assert a.diamonds == {"XD1"} and a.end_signal == "XI" and a.sections[-1] == "IG"
+
+
+@pytest.mark.parametrize("name", ["gaotie", DANXIAN])
+def test_the_view_reads_what_the_field_shows_now(name: str) -> None:
+    """What the oracle's view reads again only after a lamp command (the signals lit beyond stop), and what it reads
+    of many sections at once (the occupied ones), is what the field shows at every cycle of random operation."""
+    sim = Simulation(load(name))
+    watch = Watch(sim)
+    gen = StepGenerator(sim, random.Random(11))
+    field, sections = sim.field, list(sim.station.sections)
+    stop = {s: set(lamps.commanded) for s, lamps in field.lamps.items()}  # every signal at stop at power-on
+    seen: set[tuple[str, ...]] = set()
+    for _ in range(120):
+        lines, cycles = gen.next()
+        for line in lines:
+            sim.command(line)
+        for _ in range(cycles):
+            sim.step()
+            showing = watch.view.showing()
+            assert showing == tuple(s for s, lamps in field.lamps.items() if lamps.commanded - stop[s])
+            assert watch.view.occupied(sections) == {s for s in sections if not field.circuits[s].up}
+            seen.add(showing)
+    assert len(seen) >= 2  # a signal opened

@@ -515,6 +515,5 @@ class Oracle:
                                      f"does not see ({near[0][0]} at {near[0][1]:g} m; {sec} shows clear)",
                                      hazard=True)
         self.was_moving = moving
-        clear = view.clear
-        self.turnout_sections_occupied = {sec for sec in self.turnout_sections if not clear(sec)}
+        self.turnout_sections_occupied = view.occupied(self.turnout_sections)
 

@@ -7,6 +7,7 @@ turnout is locked, as the operator's console shows it; what must be locked is th
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from typing import Protocol
 
 
@@ -38,6 +39,9 @@ class FieldView(Protocol):
 
     def clear(self, section: str) -> bool:
         """The track relay (GJ) of the section is up."""
+
+    def occupied(self, sections: Iterable[str]) -> set[str]:
+        """Those of ``sections`` whose track relay is down (what ``clear`` says of each, read at once)."""
 
     def locked(self, turnout: str) -> bool:
         """The interlocking reports the turnout locked (route, overlap, single lock, guide lock, power-up)."""

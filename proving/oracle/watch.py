@@ -8,6 +8,7 @@ block machines, and the console's answer to "is this turnout locked".
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -45,15 +46,17 @@ class SimulationView:
         # read only: shared by every view of a simulation of this station under these rules
         self.stop, self.platform_keys = sim.station.derived(_view_tables, rules or sim.rules)
         self._wheelsets: tuple[float, list[tuple[str, float]]] | None = None
+        self._showing: tuple[int, tuple[str, ...]] = (-1, ())
 
-    def showing(self) -> list[str]:
-        """Signals with a lamp lit other than their stop lamp."""
-        out = []
-        for sig, lamps in self.field.lamps.items():
-            commanded = lamps.commanded
-            if commanded and commanded != self.stop[sig]:
-                out.append(sig)
-        return out
+    def showing(self) -> tuple[str, ...]:
+        """Signals with a lamp lit other than their stop lamp (read again only after the field applied a lamp
+        command: its ``lamp_stamp`` moved)."""
+        stamp = self.field.lamp_stamp
+        if stamp != self._showing[0]:
+            stop = self.stop
+            self._showing = (stamp, tuple(sig for sig, lamps in self.field.lamps.items()
+                                          if lamps.commanded and lamps.commanded != stop[sig]))
+        return self._showing[1]
 
     def lit(self, signal: str) -> frozenset[str]:
         lit = set(self.field.lamps[signal].lit())
@@ -98,6 +101,9 @@ class SimulationView:
 
     def clear(self, section: str) -> bool:
         return self.field.track_up(section)
+
+    def occupied(self, sections: Iterable[str]) -> set[str]:
+        return self.field.tracks_down(sections)
 
     def locked(self, turnout: str) -> bool:
         return self.sim.turnout_locked(turnout)
