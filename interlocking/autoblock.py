@@ -95,7 +95,7 @@ def _ahead_first(signals: list[tuple[str, tuple[str, ...], str | None]]
 def cab_codes(station: Station, rules: RuleSet, routes: Iterable[RouteState],
               aspects: dict[str, str]) -> dict[str, str | None]:
     """The low-frequency code on every coded section: the code of the signal ahead of a train in its route."""
-    codes: dict[str, str | None] = {s.id: None for s in station.model.sections if s.coded}
+    codes: dict[str, str | None] = dict.fromkeys(station.derived(_coded))
     for rs in routes:
         r = rs.route
         if r.kind != "train" or rs.stage not in (RouteStage.open, RouteStage.guide, RouteStage.in_use):
@@ -106,3 +106,8 @@ def cab_codes(station: Station, rules: RuleSet, routes: Iterable[RouteState],
             if s in codes and not rs.released[i]:
                 codes[s] = code
     return codes
+
+
+def _coded(station: Station) -> tuple[str, ...]:
+    """The coded sections, in the station's order."""
+    return tuple(s.id for s in station.model.sections if s.coded)
