@@ -11,6 +11,7 @@ only by hand and by signal.
 
 from __future__ import annotations
 
+import weakref
 from collections import deque
 from pathlib import Path
 
@@ -60,7 +61,11 @@ class World:
         for reason in self.field.held_down().values():  # sections past their track-circuit model's range
             self.log("alarm", reason)
         motion = make_engine(engine, self.station, cycle_s)
-        self.fleet = Fleet(self.station, self.field, lambda: self.view.outputs.signals, self.log, self.auto_limit,
+        # what the fleet calls back does not keep the world alive: a dropped world is freed at once, not by the
+        # garbage collector (verify drops thousands of simulations)
+        me = weakref.proxy(self)
+        self.fleet = Fleet(self.station, self.field, lambda: me.view.outputs.signals,
+                           lambda kind, text: me.log(kind, text), lambda train: me.auto_limit(train),
                            engine=motion, rules=self.rules)
         attach_engine(motion, self.fleet)
         self.wiring.power_on(self.view.inputs, self.view.outputs)

@@ -149,6 +149,7 @@ class Watch:
         self.oracle = Oracle(sim.station, rules or sim.rules, cycle_s=sim.cycle_s, reaction=reaction)
         self.view = SimulationView(sim, rules)
         self.violations: list[Violation] = []
+        self._wrapped: dict[str, object] = {}  # what ``attach`` wrapped, by name
         self.hazards: list[Violation] = []
         self.cycles = 0
         self._last: tuple[object, ...] = ()
@@ -183,6 +184,19 @@ class Watch:
         sim.step = checked_step  # type: ignore[method-assign]
         sim.command = noted_command  # type: ignore[method-assign]
         sim.rest = watched_rest  # type: ignore[method-assign]
+        self._wrapped = {"step": step, "command": command, "rest": rest}
+
+    def detach(self) -> None:
+        """Stop watching: the simulation's ``step``, ``command`` and ``rest`` are what they were before ``attach``
+        (what the watch found stays). The wrappers refer to the simulation and the simulation to them, so a watched
+        simulation dropped without this is freed only by the garbage collector."""
+        for name, was in self._wrapped.items():
+            if getattr(was, "__self__", None) is self.sim and getattr(was, "__func__", None) is getattr(
+                    type(self.sim), name, None):
+                delattr(self.sim, name)  # the class's own method again
+            else:
+                setattr(self.sim, name, was)
+        self._wrapped = {}
 
     def note(self, line: str, result: Result) -> None:
         try:

@@ -8,6 +8,7 @@ test script that replays it (``liansuo test``). Whatever the oracle finds during
 
 from __future__ import annotations
 
+import weakref
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -73,6 +74,7 @@ class Probe:
         self.ctx = ctx
         self.sim = Simulation(ctx.station, cycle_s=ctx.cycle_s, rules=ctx.rules, table=ctx.table)
         self.watch = Watch(self.sim)
+        weakref.finalize(self, self.watch.detach)  # a dropped probe's simulation is freed at once (Watch.detach)
         self._reported = 0
         self.lines: list[str] = []
         self._cycles = 0  # cycles run since the last line written
