@@ -284,10 +284,8 @@ class Field:
             self.t += dt
 
     def _relight(self, signal: str, lit: set[str]) -> None:
-        lamps = self.lamps[signal]
         self.lamp_stamp += 1
-        before = lamps.proving()
-        if lamps.apply(lit) != before:
+        if self.lamps[signal].command(lit):
             self._changes.signals.add(signal)
 
     # ---- relays the interlocking reads ------------------------------------------------------------------------

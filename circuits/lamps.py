@@ -119,10 +119,20 @@ class SignalLamps:
 
     def apply(self, lit_lamps: set[str]) -> dict[str, bool]:
         """Command exactly ``lit_lamps`` lit; return each lamp's proving (DJ up) after the currents settle."""
+        self.command(lit_lamps)
+        return self.proving()
+
+    def command(self, lit_lamps: set[str]) -> bool:
+        """Command exactly ``lit_lamps`` lit; whether the proving of any lamp (its DJ) changed."""
         for name in lit_lamps:
             self._lamp(name)
-        self.commanded = set(lit_lamps)
-        return {name: lamp.apply(name in self.commanded) for name, lamp in self.lamps.items()}
+        commanded = self.commanded = set(lit_lamps)
+        changed = False
+        for name, lamp in self.lamps.items():
+            was = lamp.dj.up
+            if lamp.apply(name in commanded) is not was:
+                changed = True
+        return changed
 
     def proving(self) -> dict[str, bool]:
         """DJ state per lamp as last applied."""
