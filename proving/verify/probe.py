@@ -8,7 +8,6 @@ test script that replays it (``liansuo test``). Whatever the oracle finds during
 
 from __future__ import annotations
 
-import weakref
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -74,10 +73,18 @@ class Probe:
         self.ctx = ctx
         self.sim = Simulation(ctx.station, cycle_s=ctx.cycle_s, rules=ctx.rules, table=ctx.table)
         self.watch = Watch(self.sim)
-        weakref.finalize(self, self.watch.detach)  # a dropped probe's simulation is freed at once (Watch.detach)
         self._reported = 0
         self.lines: list[str] = []
         self._cycles = 0  # cycles run since the last line written
+
+    def __del__(self) -> None:
+        """A dropped probe lets its simulation go at once: the watch's wrappers and the simulation refer to each
+        other, which only the garbage collector would otherwise free (:meth:`~proving.oracle.watch.Watch.detach`)."""
+        try:
+            watch = self.watch
+        except AttributeError:  # the simulation could not be built
+            return
+        watch.detach()
 
     def _oracle(self) -> None:
         """Record what the oracle found since the last look, each finding once per verify run."""
