@@ -102,16 +102,23 @@ def _table(turnouts: int) -> dict[str, Any]:
         done = subprocess.run([sys.executable, "-c", _TABLE_CHILD, str(station), str(table)], check=True,
                               capture_output=True, text=True)
         seconds = time.perf_counter() - t0
-        peak_kb = int(done.stdout.split()[-1])  # the child's own peak (ru_maxrss is in KB on Linux)
+        peak_kb = int(done.stdout.split()[-1])  # the child's own peak, in KB
         size = table.stat().st_size
     return {f"table_hub{turnouts}_peak_mb": round(peak_kb / 1024, 1), f"table_hub{turnouts}_json_s": round(seconds, 2),
             f"table_hub{turnouts}_build_s": round(build_s, 2), f"table_hub{turnouts}_json_mb": round(size / 1e6, 1)}
 
 
-# ``liansuo table STATION --format json -o FILE`` in a child of its own, which then prints its own peak memory
+# ``liansuo table STATION --format json -o FILE`` in a child of its own, which then prints its own peak memory in KB:
+# on Linux the high-water mark of its own memory (VmHWM), since getrusage's ru_maxrss of a child started by fork and
+# exec keeps the peak of the parent it was forked from (a bench that had just verified hub200 made the table's
+# figure 348 MB where the child itself peaked at 162); elsewhere ru_maxrss (KB on Linux, bytes on macOS)
 _TABLE_CHILD = ("import resource, sys\nfrom liansuo.cli.main import main\n"
                 "main(['table', sys.argv[1], '--format', 'json', '-o', sys.argv[2]])\n"
-                "print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss)")
+                "try:\n"
+                "    hwm = [line for line in open('/proc/self/status') if line.startswith('VmHWM:')]\n"
+                "    print(int(hwm[0].split()[1]))\n"
+                "except (OSError, IndexError):\n"
+                "    print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss)")
 
 
 def _soak(sizes: ScaleSizes, workers: int) -> float:

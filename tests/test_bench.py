@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import math
 from collections import Counter
+from pathlib import Path
 
 import pytest
 
@@ -112,6 +113,20 @@ def test_impossible_hub_is_refused() -> None:
         generate_hub(5, 4)
     with pytest.raises(ValueError, match="cannot be laid out"):
         generate_hub(30, 4)
+
+
+@pytest.mark.skipif(not Path("/proc/self/status").exists(), reason="the child's own peak is read from /proc (Linux)")
+def test_the_tables_peak_is_its_own_whatever_the_bench_holds() -> None:
+    """The table's peak memory is the child's that writes it, not the bench's: a child started by fork and exec
+    reports the peak of the parent it came from in getrusage (a bench that had just verified hub200 showed 348 MB for
+    a table writer that peaked at 162)."""
+    from liansuo.bench.scale import _table
+
+    held = bytearray(300 * 1024 * 1024)  # the bench holding 300 MB, every page of it resident
+    for i in range(0, len(held), 4096):
+        held[i] = 1
+    assert 0 < _table(8)["table_hub8_peak_mb"] < 200
+    del held
 
 
 def test_the_scale_figures_are_reported_for_verify_soak_and_the_table() -> None:
