@@ -19,4 +19,4 @@ def register(add: Add) -> None:
     sp.add_argument("--quick", action="store_true", help="fewer cycles (under a minute)")
     sp.add_argument("--format", choices=("json", "text"), default="json", help="json (default) or text")
     sp.add_argument("--scale", action="store_true", help="also verify, soak and write the table of large hubs "
-                    "(hours in full; with --quick minutes): docs/benchmark.md")
+                    "(about a quarter of an hour in full on 2 cores; with --quick minutes): docs/benchmark.md")
