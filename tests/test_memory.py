@@ -52,9 +52,16 @@ def test_a_dropped_simulation_is_freed_at_once() -> None:
         watch = Watch(sim)
         sim.run(1.0)
         assert watch.cycles == 5  # the first look, then 4 cycles
+        inner = Watch(sim)  # a second watch wraps the first one's wrappers; detached, it gives them back
+        sim.run(1.0)
+        assert watch.cycles == 9 and inner.cycles == 5  # each: its first look, then 4 cycles
+        inner.detach()
+        sim.run(1.0)
+        assert watch.cycles == 13 and inner.cycles == 5
         watch.detach()
         sim.run(1.0)
-        assert watch.cycles == 5 and "step" not in vars(sim) and sim.t == 2.0
+        assert watch.cycles == 13 and "step" not in vars(sim) and sim.t == 4.0
+        del inner
         del sim, watch
         assert gc.collect() == 0
     finally:

@@ -149,10 +149,10 @@ class Watch:
         self.oracle = Oracle(sim.station, rules or sim.rules, cycle_s=sim.cycle_s, reaction=reaction)
         self.view = SimulationView(sim, rules)
         self.violations: list[Violation] = []
-        self._wrapped: dict[str, object] = {}  # what ``attach`` wrapped, by name
         self.hazards: list[Violation] = []
         self.cycles = 0
         self._last: tuple[object, ...] = ()
+        self._wrapped: dict[str, object] = {}  # what ``attach`` set on the simulation: name -> what it had of its own
         if attach:
             self.attach()
         self.check()
@@ -181,18 +181,18 @@ class Watch:
             self.cycles += n
             return n
 
+        own = vars(sim)  # wrappers set there before this watch's (None: the class's method)
+        self._wrapped = {name: own.get(name) for name in ("step", "command", "rest")}
         sim.step = checked_step  # type: ignore[method-assign]
         sim.command = noted_command  # type: ignore[method-assign]
         sim.rest = watched_rest  # type: ignore[method-assign]
-        self._wrapped = {"step": step, "command": command, "rest": rest}
 
     def detach(self) -> None:
         """Stop watching: the simulation's ``step``, ``command`` and ``rest`` are what they were before ``attach``
         (what the watch found stays). The wrappers refer to the simulation and the simulation to them, so a watched
         simulation dropped without this is freed only by the garbage collector."""
         for name, was in self._wrapped.items():
-            if getattr(was, "__self__", None) is self.sim and getattr(was, "__func__", None) is getattr(
-                    type(self.sim), name, None):
+            if was is None:
                 delattr(self.sim, name)  # the class's own method again
             else:
                 setattr(self.sim, name, was)

@@ -1,9 +1,9 @@
 """``liansuo verify``: the automatic interlocking test (联锁试验) of a whole station.
 
 Every route of the table goes through the items of a real test record (:mod:`.routes`, :mod:`.release`), every
-pair of routes is tried together (:mod:`.pairs`) unless the two are compatible and apart (:mod:`.apart`), the station
-data is checked against the topology and the design
-rules (:mod:`.data`), and the throats' guide total lock is tried. Each dynamic check runs on a fresh simulation
+pair of routes is tried together (:mod:`.pairs`) unless the two are compatible and apart (:mod:`.apart`), the
+station data is checked against the topology and the design rules (:mod:`.data`), and the throats' guide total lock
+is tried. Each dynamic check runs on a fresh simulation
 driven only through the command language, so every failure comes with the script that shows it.
 """
 
