@@ -12,6 +12,7 @@ from itertools import pairwise
 import networkx as nx
 
 from . import limits
+from .crossovers import undeclared_crossings
 from .fit import metres, number
 from .schema import (
     Button,
@@ -206,6 +207,9 @@ class _Checker:
             if s.type is CircuitType.zpw2000a and s.carrier is None:
                 self.err(("sections", k, "type"), f"ZPW-2000A section '{s.id}' has no carrier",
                          "add e.g. 'carrier: 2300-1' (down line 1700/2300, up line 2000/2600)")
+            if s.safety_line and s.role is not SectionRole.spur:
+                self.err(("sections", k, "safety_line"), f"section '{s.id}' is a safety line but its role is "
+                         f"{s.role.value}", "a safety line (安全线) is a spur: give it 'role: spur'")
             if s.type is not CircuitType.zpw2000a and s.carrier is not None:
                 self.err(("sections", k, "carrier"), f"section '{s.id}' ({s.type.value}) cannot have a ZPW-2000A "
                          "carrier", "remove 'carrier', or make the section 'type: zpw2000a'")
@@ -260,12 +264,15 @@ class _Checker:
         section_tracks: dict[str, list[str]] = {}
         for t in self.m.tracks:
             section_tracks.setdefault(t.section, []).append(t.id)
+        # the two tracks of a diamond crossing may share one section: the crossing's track circuit covers both
+        g.add_edges_from(d.tracks for d in self.m.diamonds if all(g.has_node(t) for t in d.tracks))
         for k, s in enumerate(self.m.sections):
             tracks = section_tracks.get(s.id, [])
             if len(tracks) > 1 and not nx.is_connected(g.subgraph(tracks)):
                 self.err(("sections", k, "id"),
                          f"section '{s.id}' is in pieces: its tracks ({', '.join(tracks)}) are not joined through "
-                         "turnouts", "each section is one stretch bounded by joints or ends; split it in two ids")
+                         "turnouts or a diamond", "each section is one stretch bounded by joints or ends; split it "
+                         "in two ids")
 
     def zpw_lengths(self) -> None:
         """A ZPW-2000A section is no longer than :data:`limits.ZPW_SECTION`, and its explicit capacitor positions lie
@@ -524,6 +531,19 @@ class _Checker:
                 self.err(("diamonds", k, "at"), f"diamond {d.id} at {metres(d.at)} is not on both tracks (they run "
                          f"side by side from {number(lo)} to {metres(hi)})", "give the point where the two tracks "
                          "cross")
+        if not self.errors:
+            self.scissors()
+
+    def scissors(self) -> None:
+        """Two crossover pairs whose diagonals cross (a scissors crossover, 交叉渡线) need their diamond declared:
+        without it nothing would keep the other pair away from a route over one diagonal."""
+        for c in undeclared_crossings(self.m):
+            self.err(("turnouts", c.turnout_index, "pair"),
+                     f"crossover pairs {c.pairs[0]} and {c.pairs[1]} cross each other (a scissors crossover, "
+                     f"交叉渡线): their diagonals {c.tracks[0]} and {c.tracks[1]} meet near {metres(c.at)}, and no "
+                     "diamond is declared there, so nothing would protect the crossing",
+                     f"declare it: 'diamonds: [{{id: XD, tracks: [{c.tracks[0]}, {c.tracks[1]}], "
+                     f"at: {number(c.at)}}}]'")
 
     def markers(self) -> None:
         tracks = {t.id: t for t in self.m.tracks}
@@ -623,6 +643,10 @@ class _Checker:
             if o.end is not None and ending[(o.end_signal, o.end)] > 1:
                 self.err(("overlaps", k, "end"), f"signal {o.end_signal} has two overlaps ending at '{o.end}'",
                          "alternative overlaps end at different buttons")
+        for m, f in enumerate(self.m.overrides.fouling):
+            if f.section not in sections:
+                self.err(("overrides", "fouling", m, "section"), f"override names unknown section '{f.section}'",
+                         "name a section listed under 'sections:'")
         for key in ("protection", "remove_protection"):
             for m, p in enumerate(getattr(self.m.overrides, key)):
                 if p.turnout not in turnouts:

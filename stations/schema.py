@@ -247,6 +247,7 @@ class Section(Strict):
     capacitors: Capacitors | None = None
     line_class: LineClass | None = None  # ZPW-2000A only; none given: conventional
     speed_kmh: Speed | None = None
+    safety_line: bool = False  # a safety line (安全线): a spur that isolates the end of a receiving track
     name: str | None = None
 
 
@@ -458,12 +459,22 @@ class EnemyOverride(Strict):
     why: str = Field(default="named in the station file", min_length=1)
 
 
+class FoulingOverride(Strict):
+    """A section a route must find clear although the topology does not say so (an added track condition, 侵限
+    区段): a siding whose vehicles foul the route where no fouling point is drawn, say."""
+
+    route: RouteId
+    section: Id
+
+
 class Overrides(Strict):
-    """What topology alone cannot decide: extra protection turnouts, added enemies, routes that must not exist."""
+    """What topology alone cannot decide: extra protection turnouts, added enemies and track conditions, routes that
+    must not exist."""
 
     protection: list[ProtectionOverride] = Field(default_factory=list)
     remove_protection: list[ProtectionOverride] = Field(default_factory=list)
     enemies: list[EnemyOverride] = Field(default_factory=list)
+    fouling: list[FoulingOverride] = Field(default_factory=list)
     forbid: list[RouteId] = Field(default_factory=list)
 
 
