@@ -30,7 +30,8 @@ Add = Callable[[str, Handler, str], argparse.ArgumentParser]
 
 # in the order of the help: the station, its table and track circuits, proving it, timing it, the console
 REGISTER: tuple[Callable[[Add], None], ...] = (
-    partial(stations.register, more_warnings=(zpwcli.check_warnings,),  # stations, check, generate
+    # stations, check, generate
+    partial(stations.register, more_warnings=(zpwcli.check_warnings, interlocking.check_warnings),
             more_errors=(interlocking.check_errors,)),
     schemas.register,  # schema
     interlocking.register,  # table

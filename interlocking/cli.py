@@ -16,24 +16,34 @@ from liansuo.stations.loader import load
 from liansuo.stations.source import Diagnostic, StationError
 from liansuo.stations.station import Station
 
+from .route import InterlockingTable
+
 Add = Callable[..., argparse.ArgumentParser]
 
 
-def check_errors(station: Station) -> list[Diagnostic]:
-    """What ``liansuo table`` would refuse in a station that loaded: its ``overrides`` naming routes, turnouts or
-    enemies the topology does not give, each with the table's own message, for ``liansuo check`` (handed to it by
-    cli/main.py). The table is derived only for a file with overrides: without them deriving it cannot fail, and on
-    a hub it takes minutes."""
-    ov = station.model.overrides
-    if not (ov.protection or ov.remove_protection or ov.enemies or ov.forbid):
-        return []
+def _table(station: Station) -> InterlockingTable | list[Diagnostic]:
+    """The station's table under the default rules, or what its derivation refused (kept with the station, so that
+    ``liansuo check`` derives it once for its errors and its warnings)."""
     from .table import build_table
 
     try:
-        build_table(station)
+        return build_table(station)
     except StationError as exc:
         return exc.diagnostics
-    return []
+
+
+def check_errors(station: Station) -> list[Diagnostic]:
+    """What ``liansuo table`` would refuse in a station that loaded (its ``overrides`` naming routes, turnouts,
+    sections or enemies the topology does not give), each with the table's own message, for ``liansuo check``
+    (handed to it by cli/main.py)."""
+    table = station.derived(_table)
+    return table if isinstance(table, list) else []
+
+
+def check_warnings(station: Station) -> list[Diagnostic]:
+    """The table's design warnings (paths it leaves out, and why), for ``liansuo check``."""
+    table = station.derived(_table)
+    return [] if isinstance(table, list) else list(table.warnings)
 
 
 def cmd_table(args: argparse.Namespace) -> int:
@@ -56,6 +66,8 @@ def cmd_table(args: argparse.Namespace) -> int:
         table = build_table(load(args.station))
     except StationError as exc:
         return bad_input(exc)
+    for w in table.warnings:  # paths the table leaves out, and why (as 'liansuo check' prints them)
+        print(w, file=sys.stderr)
     if args.format == "xlsx":
         from .tablexlsx import write_xlsx
 

@@ -15,11 +15,11 @@ only the variants of routes with a run-on are compared pair by pair.
 from __future__ import annotations
 
 from collections import defaultdict
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 
 from liansuo.rules import RuleSet
-from liansuo.stations.schema import Direction, TurnoutPosition
+from liansuo.stations.schema import TurnoutPosition
 
 from .route import Condition, Route
 
@@ -92,8 +92,9 @@ class _Enmity:
         return None
 
 
-def derive_conflicts(routes: dict[str, Route], rules: RuleSet) -> None:
-    """Fill ``conflicts``, ``conditional``, ``head_on`` and ``opposing`` of every route."""
+def derive_conflicts(routes: dict[str, Route], rules: RuleSet, is_track: Callable[[str], bool]) -> None:
+    """Fill ``conflicts``, ``conditional``, ``head_on`` and ``opposing`` of every route; ``is_track``: whether a
+    section is a station track (股道)."""
     for r in routes.values():
         r.conflicts.clear()
         r.conditional.clear()
@@ -114,15 +115,27 @@ def derive_conflicts(routes: dict[str, Route], rules: RuleSet) -> None:
             track = en.head_on(x, y)
             if track and (y.route.id in x.route.conflicts or y.route.id in x.route.conditional):
                 x.route.head_on[y.route.id] = y.route.head_on[x.route.id] = track
-    trains: dict[Direction, set[str]] = {d: set() for d in Direction}
+    _opposing(routes, is_track)
+
+
+def _opposing(routes: dict[str, Route], is_track: Callable[[str], bool]) -> None:
+    """迎面进路: the enemies of the other direction that lead onto the same station track as the route, from the
+    other end (the receiving route of the other throat, a shunting movement into the track from the far end)."""
+    onto = {rid: _track_entered(r, is_track) for rid, r in routes.items()}
     for r in routes.values():
-        if r.kind == "train":
-            trains[r.direction].add(r.id)
-    for r in routes.values():
-        if r.kind != "train":
-            continue
-        against = trains[Direction.up if r.direction is Direction.down else Direction.down]
-        r.opposing = tuple(sorted(o for o, why in r.conflicts.items() if o in against and why.startswith("section")))
+        track = onto[r.id]
+        r.opposing = () if track is None else tuple(sorted(
+            o for o in {*r.conflicts, *r.conditional}
+            if o in routes and routes[o].direction is not r.direction and onto[o] == track))
+
+
+def _track_entered(r: Route, is_track: Callable[[str], bool]) -> str | None:
+    """The station track a route ends on (a receiving or transfer route, or a shunting movement into a track)."""
+    if r.leads_into is not None:
+        return r.leads_into if is_track(r.leads_into) else None
+    if r.category == "departure" or not r.sections or not is_track(r.sections[-1]):
+        return None
+    return r.sections[-1]
 
 
 def _bulk(routes: dict[str, Route], en: _Enmity, simple: list[int]) -> None:

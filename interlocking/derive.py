@@ -43,6 +43,7 @@ class _Overlap:
     turnouts: tuple[RouteTurnout, ...]
     release_s: float
     end: str | None  # its end button, where the file names one
+    safety_line: str | None = None  # no overlap: a safety line isolates the track, its turnout lying towards it
 
 
 class _Builder:
@@ -51,7 +52,10 @@ class _Builder:
         self.rules = rules
         self.topo = station.topology
         self.errors: list[Diagnostic] = []
-        self._overlaps: dict[str, list[_Overlap]] = {}
+        self.warnings: list[Diagnostic] = []  # design warnings: routes left out of the table, and why
+        self._warned: set[tuple[str, str, Direction]] = set()
+        self._overlaps: dict[tuple[str, str], list[_Overlap]] = {}  # (home, end signal) -> from the profile
+        self._own_overlaps: dict[str, list[_Overlap]] = {}  # end signal -> the station file's
 
     # ---- routes between buttons ------------------------------------------------------------------------------
     def _train_end(self, node: str, d: Direction) -> tuple[str, str] | None:
@@ -74,10 +78,12 @@ class _Builder:
         d = sig.direction
         out: list[tuple[str, Path, str | None]] = []
         first: Move = self.topo.start_move(sig.at, d)
-        # depth-first over moves; each stack item is the list of moves so far and their length
-        stack: list[tuple[list[Move], float]] = [([first], self.st.track_length(first[0]))]
+        # depth-first over moves; each stack item is the list of moves so far, their length, and the station track
+        # a train route has run on through (its section and the joint it left it by), where it has
+        stack: list[tuple[list[Move], float, tuple[str, str] | None]] = [
+            ([first], self.st.track_length(first[0]), None)]
         while stack:
-            moves, length = stack.pop()
+            moves, length, through = stack.pop()
             last = moves[-1]
             node = self.topo.far_node(last)
             stop = False
@@ -85,8 +91,13 @@ class _Builder:
                 end = self._train_end(node, d)
                 if end is not None:
                     button, end_kind = end
-                    out.append((button, self._path(sig.at, d, moves), button if end_kind == "signal" else None))
+                    if through is not None:
+                        self._through_track(signal, button, *through, d)
+                    else:
+                        out.append((button, self._path(sig.at, d, moves), button if end_kind == "signal" else None))
                     stop = True
+                elif through is None:
+                    through = self._leaves_track(last, node)
             else:
                 for s in self.st.signals_at(node):
                     if Button.shunt in s.buttons:
@@ -107,8 +118,33 @@ class _Builder:
                         and self.st.is_station_track(self.st.tracks[last[0]].section) is False \
                         and self._has_shunt_end(node):
                     continue  # a shunting route ends where it enters a station track
-                stack.append(([*moves, nxt], length + self.st.track_length(nxt[0])))
+                stack.append(([*moves, nxt], length + self.st.track_length(nxt[0]), through))
         return out
+
+    def _leaves_track(self, last: Move, node: str) -> tuple[str, str] | None:
+        """(station track, joint) where a train route runs on from a station track (股道) out into the throat past
+        ``node``, no train signal of its direction standing there."""
+        st = self.st
+        track = st.tracks[last[0]].section
+        if node not in st.joints or not st.is_station_track(track):
+            return None
+        beyond = st.tracks[st.entry_track(node, last[1])].section
+        return None if st.is_station_track(beyond) else (track, node)  # a station track in two sections: on
+
+    def _through_track(self, signal: str, end: str, track: str, joint: str, d: Direction) -> None:
+        """A train route from ``signal`` to ``end`` that runs on through station track ``track`` past ``joint``,
+        where no train signal of its direction stands: no such route exists in a real table (it would receive and
+        depart in one, or run out onto a line against its direction), so it is left out, with a design warning."""
+        key = (track, joint, d)
+        if key in self._warned:
+            return
+        self._warned.add(key)
+        st = self.st
+        k = next(i for i, sec in enumerate(st.model.sections) if sec.id == track)
+        self._warn(("sections", k, "id"), f"station track {track} has no {d.value} train signal at {joint}: the "
+                   f"path from {signal} to {end} would run on through it as one train route (receiving and departing "
+                   "in one); it is left out of the table",
+                   f"add the {d.value} starting signal at {joint}, or leave it out on purpose")
 
     def _has_shunt_end(self, node: str) -> bool:
         return any(Button.shunt in s.buttons for s in self.st.signals_at(node))
@@ -163,7 +199,9 @@ class _Builder:
                 lo, hi = st.joint_tracks(far.node)
                 track, node_from = (hi if lo == track else lo), far.node
                 joints += 1
-        for x in sorted(crossing):
+        for x in sorted(crossing):  # a vehicle standing on a track that crosses the path fouls the crossing
+            diamond = next(d for t in tracks for d, o in st.crossings.get(t, ()) if o == x)
+            fouling.append(FoulingSection(st.tracks[x].section, diamond=diamond))
             for port in st.track_ports[x]:
                 if port.leg is not None:
                     protect(port.node, port.leg)
@@ -362,7 +400,13 @@ class _Builder:
                 "receiving" if sig.kind is SignalKind.home else "transfer")
         else:
             category = "shunting"
-        overlaps = self._overlap(end_signal) if kind == "train" else []
+        overlaps = self._overlap(start, end_signal) if kind == "train" and category == "receiving" else (
+            self._file_overlaps(end_signal) if kind == "train" else [])
+        isolating = next((o for o in overlaps if o.safety_line), None)
+        if isolating is not None:  # a safety line at the end of the track: its turnout lies towards it
+            overlaps = []
+            guard = {t.id: t for t in isolating.turnouts if t.id not in in_route and t.id not in driven}
+            extra = [t for t in extra if t.id not in guard] + list(guard.values())
         basic = overlaps[0] if overlaps else _Overlap((), (), 0.0, None)
         leads_into: str | None = None
         run_on: tuple[RunOn, ...] = ()
@@ -373,11 +417,12 @@ class _Builder:
         routes[rid] = Route(
             id=rid, kind=kind, category=category, start=start, end=end, via=via, signal=start,
             direction=path.direction, path=path, turnouts=tuple(turnouts + extra), sections=path.sections,
-            fouling=tuple(f for f in fouling if f.section not in path.sections),
+            fouling=tuple({f.section: f for f in reversed(fouling) if f.section not in path.sections}.values())[::-1],
             approach=self._approach(start), end_node=end_node, end_signal=end_signal, beyond=beyond,
             exit_link=exit_link, line_sections=line,
             overlap_sections=basic.sections, overlap_turnouts=basic.turnouts, overlap_release_s=basic.release_s,
             overlap_end=basic.end, diamonds=diamonds, leads_into=leads_into, run_on=run_on,
+            safety_line=isolating.safety_line if isolating else None,
         )
         for alt in overlaps[1:]:  # alternative overlaps (变更延续进路): the same route, another overlap
             routes[f"{rid}+{alt.end}"] = replace(
@@ -385,26 +430,36 @@ class _Builder:
                 overlap_release_s=alt.release_s, overlap_end=alt.end, overlap_alternative=True,
                 conflicts={}, conditional={}, head_on={}, added_enemies=set())
 
-    def _overlap(self, end_signal: str | None) -> list[_Overlap]:
-        """The overlaps beyond ``end_signal``, the basic one first: the station file's own entries (alternatives
-        after the first), else the one its profile calls for (:mod:`.overlap`), else none."""
+    def _overlap(self, home: str, end_signal: str | None) -> list[_Overlap]:
+        """What a receiving route from ``home`` needs beyond ``end_signal``, the basic overlap first: the station
+        file's own overlaps, else what the approach gradient outside the home signal calls for (an overlap, or the
+        turnout of a safety line: :mod:`.overlap`), else nothing."""
+        own = self._file_overlaps(end_signal)
+        if own or end_signal is None:
+            return own
+        key = (home, end_signal)
+        if key not in self._overlaps:
+            found = profile_overlap(self.st, home, end_signal, self.rules)
+            if found is None:
+                self._overlaps[key] = []
+            elif found.safety_line is not None:
+                self._overlaps[key] = [_Overlap((), tuple(RouteTurnout(t, p, "protection") for t, p in found.turnouts),
+                                                0.0, None, found.safety_line)]
+            else:
+                self._overlaps[key] = [_Overlap(found.sections, self._overlap_turnouts(found.turnouts),
+                                                self.rules.overlap_release_s, None)]
+        return self._overlaps[key]
+
+    def _file_overlaps(self, end_signal: str | None) -> list[_Overlap]:
+        """The station file's own overlaps beyond ``end_signal`` (alternatives after the basic one)."""
         if end_signal is None:
             return []
-        if end_signal not in self._overlaps:
-            own = [o for o in self.st.model.overlaps if o.end_signal == end_signal]
-            if own:
-                self._overlaps[end_signal] = [
-                    _Overlap(tuple(o.sections), self._overlap_turnouts([(t.turnout, t.position) for t in o.turnouts]),
-                             self.rules.overlap_release_s if o.release_s is None else o.release_s, o.end)
-                    for o in own]
-            else:
-                found = profile_overlap(self.st, end_signal, self.rules.overlap_gradient_per_mille)
-                if found is None:
-                    self._overlaps[end_signal] = []
-                else:
-                    self._overlaps[end_signal] = [_Overlap(found.sections, self._overlap_turnouts(found.turnouts),
-                                                           self.rules.overlap_release_s, None)]
-        return self._overlaps[end_signal]
+        if end_signal not in self._own_overlaps:
+            self._own_overlaps[end_signal] = [
+                _Overlap(tuple(o.sections), self._overlap_turnouts([(t.turnout, t.position) for t in o.turnouts]),
+                         self.rules.overlap_release_s if o.release_s is None else o.release_s, o.end)
+                for o in self.st.model.overlaps if o.end_signal == end_signal]
+        return self._own_overlaps[end_signal]
 
     def _overlap_turnouts(self, turnouts: Sequence[tuple[str, TurnoutPosition]]) -> tuple[RouteTurnout, ...]:
         """An overlap's turnouts with the crossover partners and driven turnouts they take along."""
@@ -479,9 +534,10 @@ class _Builder:
                             continue
                         self._add(routes, sig.id, kind, end, (via,), path, end_signal)
         self._apply_overrides(routes)
+        self._add_fouling(routes)
         if self.errors:
             raise StationError(self.errors)
-        derive_conflicts(routes, self.rules)
+        derive_conflicts(routes, self.rules, self.st.is_station_track)
         self._add_enemies(routes)
         if self.errors:
             raise StationError(self.errors)
@@ -501,7 +557,7 @@ class _Builder:
 
         for r in routes.values():
             r.aspects = aspects_of(r)
-        return InterlockingTable(self.st, routes, self._throats(), unselectable)
+        return InterlockingTable(self.st, routes, self._throats(), unselectable, self.warnings)
 
     def _via(self, path: Path, basic: Path) -> str | None:
         basic_nodes = set(basic.joints) | set(basic.tracks)
@@ -550,6 +606,19 @@ class _Builder:
                         continue
                     r.turnouts = tuple(t for t in r.turnouts if not (t.id == p.turnout and t.role == "protection"))
 
+    def _add_fouling(self, routes: dict[str, Route]) -> None:
+        """The station file's added track conditions (``overrides.fouling``): sections a route must find clear."""
+        for k, f in enumerate(self.st.model.overrides.fouling):
+            r = routes.get(f.route)
+            if r is None:
+                self._err(("overrides", "fouling", k, "route"), f"override names route '{f.route}', which does not "
+                          "exist", f"routes are named START-END; see 'liansuo table {self.st.id}'")
+            elif f.section in r.sections or any(x.section == f.section for x in r.fouling):
+                self._err(("overrides", "fouling", k, "section"), f"route {r.id} already checks section "
+                          f"{f.section}", "remove this entry; the table derives it")
+            else:
+                r.fouling = (*r.fouling, FoulingSection(f.section))
+
     def _add_enemies(self, routes: dict[str, Route]) -> None:
         """The station file's added enemies (``overrides.enemies``), both ways, after the derived ones."""
         for k, e in enumerate(self.st.model.overrides.enemies):
@@ -574,6 +643,13 @@ class _Builder:
             b.added_enemies.add(a.id)
             a.conditional.pop(b.id, None)
             b.conditional.pop(a.id, None)
+
+    def _warn(self, loc: tuple[str | int, ...], msg: str, hint: str) -> None:
+        if self.st.source is not None:
+            d = self.st.source.diagnostic(loc, msg, hint)
+            self.warnings.append(Diagnostic(d.file, d.line, d.column, msg, hint, "warning"))
+        else:
+            self.warnings.append(Diagnostic("<station>", 1, 1, msg, hint, "warning"))
 
     def _err(self, loc: tuple[str | int, ...], msg: str, hint: str) -> None:
         if self.st.source is not None:

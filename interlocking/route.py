@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 from typing import Literal
 
 from liansuo.stations.schema import Direction, TurnoutPosition
+from liansuo.stations.source import Diagnostic
 from liansuo.stations.station import Station
 from liansuo.stations.topology import Path
 
@@ -33,11 +34,14 @@ class RouteTurnout:
 
 @dataclass(frozen=True)
 class FoulingSection:
-    """A section beyond a joint laid inside a turnout's fouling point: it must be clear for the route."""
+    """A section the route must find clear beside its path (侵限): beyond a joint laid inside the fouling point of
+    ``turnout`` (lying ``position`` for the route), the section of a track that crosses the path at ``diamond`` (a
+    vehicle standing there fouls the crossing), or one the station file adds (``overrides.fouling``)."""
 
     section: str
-    turnout: str
-    position: TurnoutPosition
+    turnout: str | None = None
+    position: TurnoutPosition | None = None
+    diamond: str | None = None
 
 
 @dataclass(frozen=True)
@@ -79,6 +83,7 @@ class Route:
     overlap_release_s: float = 0.0
     overlap_end: str | None = None  # the overlap's end button, where the file names one
     overlap_alternative: bool = False  # set only by pressing ``overlap_end`` (变更延续进路): not the basic overlap
+    safety_line: str | None = None  # the safety line (安全线) that isolates the receiving track, its turnout protecting
     diamonds: tuple[str, ...] = ()  # diamond crossings the path runs over
     leads_into: str | None = None  # station track or spur a shunting route enters at sight at its end
     run_on: tuple[RunOn, ...] = ()  # one per way the turnouts beyond may lie
@@ -124,13 +129,15 @@ class Route:
             "aspects": list(self.aspects),
             "turnouts": [{"id": t.id, "position": t.position.value, "role": t.role} for t in self.turnouts],
             "sections": list(self.sections),
-            "fouling_sections": [{"section": f.section, "turnout": f.turnout, "position": f.position.value}
+            "fouling_sections": [{"section": f.section, "turnout": f.turnout,
+                                  "position": f.position.value if f.position else None, "diamond": f.diamond}
                                  for f in self.fouling],
             "approach": list(self.approach),
             "overlap": ({"sections": list(self.overlap_sections),
                          "turnouts": [{"id": t.id, "position": t.position.value} for t in self.overlap_turnouts],
                          "release_s": self.overlap_release_s, "end": self.overlap_end,
                          "alternative": self.overlap_alternative} if self.overlap_sections else None),
+            "safety_line": self.safety_line,
             "diamonds": list(self.diamonds),
             "leads_into": self.leads_into,
             "run_on": [{"when": {t: p.value for t, p in ro.when}, "sections": list(ro.sections),
@@ -155,6 +162,7 @@ class InterlockingTable:
     routes: dict[str, Route]
     throats: dict[str, tuple[str, ...]]  # throat name (its home signals) -> turnouts
     unselectable: list[str] = field(default_factory=list)  # paths with no distinguishing via button
+    warnings: list[Diagnostic] = field(default_factory=list)  # design warnings: routes left out, and why
 
     _buttons: dict[tuple[str, str, str, tuple[str, ...], str | None], Route] = field(
         default_factory=dict, init=False, repr=False, compare=False)

@@ -10,6 +10,7 @@ Text, CSV and xlsx all print these cells, so the three agree; docs/interlocking-
 - 轨道区段: the route's sections, then ``<5DG>`` for a section inside a turnout's fouling point (侵限).
 - 敌对信号: by signal, never the route's own; ``XI(列)`` / ``XI(调)`` where only the train or only the shunting routes
   of XI are enemies; ``<1>D1`` / ``<(1)>D1`` where D1 is an enemy only with turnout 1 normal / reverse.
+- 迎面进路: the enemies of the other direction onto the same station track, ``S(列)`` / ``D2(调)``.
 """
 
 from __future__ import annotations
@@ -41,10 +42,11 @@ COLUMNS: tuple[Column, ...] = (
     Column("buttons", "按下按钮", 11),
     Column("signal", "信号机", 6),
     Column("aspects", "显示", 8),
-    Column("turnouts", "道岔", 17),
-    Column("sections", "轨道区段", 15),
-    Column("enemies", "敌对信号", 16),
-    Column("other", "其他联锁", 16),
+    Column("turnouts", "道岔", 15),
+    Column("sections", "轨道区段", 13),
+    Column("enemies", "敌对信号", 13),
+    Column("opposing", "迎面进路", 8),
+    Column("other", "其他联锁", 14),
 )
 DIRECTION_ZH = {Direction.down: "下行", Direction.up: "上行"}
 CATEGORY_ZH = {"receiving": "接车", "departure": "发车", "transfer": "转线", "shunting": "调车"}
@@ -187,6 +189,18 @@ class _Builder:
                   for (s, k), conds in only.items() for c in conds]
         return " ".join(text for _o, _c, text in sorted(items))
 
+    def opposing(self, r: Route) -> str:
+        """迎面进路: the routes of the other direction onto the same station track, by signal and kind (列 train,
+        调 shunting)."""
+        seen: dict[str, set[str]] = {}
+        for rid in r.opposing:
+            o = self.table.routes.get(rid)
+            if o is not None:
+                seen.setdefault(o.signal, set()).add(o.kind)
+        items = sorted(seen.items(), key=lambda kv: self.signal_order.get(kv[0], 0))
+        return " ".join(f"{sig}({'列' if kind == 'train' else '调'})" for sig, kinds in items
+                        for kind in sorted(kinds, key=("train", "shunt").index))
+
     def other(self, r: Route) -> str:
         items = []
         link = next((lk for lk in self.st.model.links if lk.id == r.exit_link), None)
@@ -204,6 +218,8 @@ class _Builder:
             items += [f"{p.section}站台门关闭" for p in self.st.model.platforms if p.screen_doors and p.section in on]
         if r.diamonds:
             items.append("菱形交叉 " + " ".join(r.diamonds))
+        if r.safety_line:
+            items.append(f"安全线 {r.safety_line}")
         if r.overlap_sections:
             to = f"至 {r.overlap_end} " if r.overlap_end else ""
             items.append(f"延续进路 {to}" + " ".join([*r.overlap_sections, self.turnouts(r.overlap_turnouts)]).strip()
@@ -220,7 +236,8 @@ class _Builder:
             "mode": "变更延续" if r.overlap_alternative else "变通" if r.via else "基本",
             "buttons": " ".join(self.button(b, r.kind) for b in r.buttons),
             "signal": r.signal, "aspects": "/".join(r.aspects), "turnouts": self.turnouts(r.turnouts),
-            "sections": self.sections(r), "enemies": self.enemies(r), "other": self.other(r),
+            "sections": self.sections(r), "enemies": self.enemies(r), "opposing": self.opposing(r),
+            "other": self.other(r),
         }
         return Row(r.id, cells)
 

@@ -20,8 +20,8 @@ _ROUTE: dict[str, Any] = {
     "type": "object",
     "additionalProperties": False,
     "required": ["id", "kind", "category", "start", "end", "via", "signal", "direction", "aspects", "turnouts",
-                 "sections", "fouling_sections", "approach", "overlap", "diamonds", "leads_into", "run_on",
-                 "length_m", "exit_link", "line_sections", "conflicts", "conflict_reasons",
+                 "sections", "fouling_sections", "approach", "overlap", "safety_line", "diamonds", "leads_into",
+                 "run_on", "length_m", "exit_link", "line_sections", "conflicts", "conflict_reasons",
                  "conditional_conflicts", "opposing"],
     "properties": {
         "id": _STR, "kind": {"enum": ["train", "shunt"]},
@@ -29,8 +29,9 @@ _ROUTE: dict[str, Any] = {
         "start": _STR, "end": _STR, "via": _STRS, "signal": _STR, "direction": {"enum": ["down", "up"]},
         "aspects": _STRS, "turnouts": {"type": "array", "items": _TURNOUT}, "sections": _STRS,
         "fouling_sections": {"type": "array", "items": {
-            "type": "object", "required": ["section", "turnout", "position"], "additionalProperties": False,
-            "properties": {"section": _STR, "turnout": _STR, "position": _POSITION}}},
+            "type": "object", "required": ["section", "turnout", "position", "diamond"], "additionalProperties": False,
+            "properties": {"section": _STR, "turnout": _NULL_STR, "position": {"oneOf": [{"type": "null"}, _POSITION]},
+                           "diamond": _NULL_STR}}},
         "approach": _STRS,
         "overlap": {"oneOf": [{"type": "null"}, {
             "type": "object", "required": ["sections", "turnouts", "release_s", "end", "alternative"],
@@ -39,7 +40,7 @@ _ROUTE: dict[str, Any] = {
                            "alternative": {"type": "boolean"}, "turnouts": {"type": "array", "items": {
                 "type": "object", "required": ["id", "position"], "additionalProperties": False,
                 "properties": {"id": _STR, "position": _POSITION}}}}}]},
-        "diamonds": _STRS, "leads_into": _NULL_STR,
+        "safety_line": _NULL_STR, "diamonds": _STRS, "leads_into": _NULL_STR,
         "run_on": {"type": "array", "items": {
             "type": "object", "required": ["when", "sections", "turnouts", "leads_into"], "additionalProperties": False,
             "properties": {"when": _WHEN, "sections": _STRS, "turnouts": {"type": "array", "items": _TURNOUT},

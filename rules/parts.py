@@ -34,7 +34,9 @@ class InterlockingRules(Part):
 
     release_s: dict[str, Seconds]  # manual time release, by route kind (train, shunt)
     section_fault_release_s: Seconds
-    overlap_gradient_per_mille: Annotated[float, Field(ge=0)]  # profile-derived overlap beyond a steeper fall
+    overlap_gradient_per_mille: Annotated[float, Field(ge=0)]  # an approach falling more steeply calls for an overlap
+    # the braking distance within which the approach to a home signal is looked at: line speed (km/h, up to) -> m
+    braking_distance_m: dict[Annotated[int, Field(gt=0)], Metres] = Field(min_length=1)
     overlap_release_s: Seconds  # for an overlap whose station file gives no release_s of its own
     squeeze_alarm_s: Seconds
     turnout_concurrency: Annotated[int, Field(ge=1)]
@@ -44,6 +46,12 @@ class InterlockingRules(Part):
     guide_close_s: Seconds
     approach_locking: ApproachLocking
     enemy_onto_track: list[tuple[Literal["train", "shunt"], Literal["train", "shunt"]]]
+
+    def braking_distance(self, line_speed_kmh: float) -> float:
+        """The braking distance for a line speed: the figure of the smallest speed not below it (the largest listed
+        beyond the table)."""
+        table = sorted(self.braking_distance_m.items())
+        return next((m for v, m in table if v >= line_speed_kmh), table[-1][1])
 
     def problems(self) -> list[tuple[Loc, str]]:
         if set(self.release_s) == {"train", "shunt"}:

@@ -44,7 +44,7 @@ def driver(tmp_path: Path, text: str) -> Driver:
 
 
 # ---- the profile and the overlaps it calls for ----------------------------------------------------------------
-def test_danxian_profile_gives_an_overlap_beyond_every_receiving_track_that_falls_away() -> None:
+def test_danxian_profile_gives_an_overlap_beyond_every_receiving_track_on_a_falling_approach() -> None:
     t = table(DANXIAN)
     assert overlap(t, "X-XI") == (("2DG",), {"2": "normal"})
     assert overlap(t, "S-SI") == (("1DG",), {"1": "normal"})
@@ -57,15 +57,33 @@ def test_danxian_profile_gives_an_overlap_beyond_every_receiving_track_that_fall
     assert "X-X3" in t.routes["XI-S"].conflicts and "X-X3" not in t.routes["X3-S"].conflicts
 
 
-@pytest.mark.parametrize(("per_mille", "overlaps"), [(0, False), (-6, False), (-6.5, True), (8, False)])
-def test_only_a_fall_steeper_than_six_per_mille_calls_for_an_overlap(per_mille: float, overlaps: bool) -> None:
-    text = edit(DANXIAN, ("{from: 1680, to: 2400, per_mille: -8}", f"{{from: 1680, to: 2400, per_mille: {per_mille}}}"))
+X_APPROACH = "{from: 0, to: 720, per_mille: -9}"  # X at 600 m: 800 m of braking distance at 100 km/h, 600 m of it here
+
+
+@pytest.mark.parametrize(("per_mille", "overlaps"), [(0, False), (-8, False), (-8.2, True), (9, False)])
+def test_only_an_approach_falling_more_than_six_per_mille_calls_for_an_overlap(per_mille: float,
+                                                                               overlaps: bool) -> None:
+    """The mean over the braking distance outside X: 600 m at ``per_mille``, 200 m beyond the model level."""
+    text = edit(DANXIAN, (X_APPROACH, f"{{from: 0, to: 720, per_mille: {per_mille}}}"))
     assert bool(table(text).routes["X-XI"].overlap_sections) is overlaps
+    assert bool(table(text).routes["S-SI"].overlap_sections)  # the other approach is unchanged
+
+
+def test_the_gradient_that_counts_is_outside_the_home_signal_over_the_braking_distance() -> None:
+    # the old reading: the throat beyond the end signal falls, the approach is level: no overlap
+    beyond = edit(DANXIAN, (X_APPROACH, "{from: 0, to: 720, per_mille: 0}"),
+                  ("{from: 1680, to: 2400, per_mille: 9}", "{from: 1680, to: 2400, per_mille: -12}"))
+    assert not table(beyond).routes["X-XI"].overlap_sections
+    # a faster line brakes over a longer distance: 1400 m at 160 km/h, of which only 600 m fall here
+    fast = edit(DANXIAN, ("line_speed_kmh: 100", "line_speed_kmh: 160"))
+    assert not table(fast).routes["X-XI"].overlap_sections
+    steeper = edit(fast, (X_APPROACH, "{from: 0, to: 720, per_mille: -15}"))  # 600 * 15 / 1400 = 6.4
+    assert table(steeper).routes["X-XI"].overlap_sections == ("2DG",)
 
 
 def test_without_a_profile_there_is_no_overlap_and_an_overlaps_entry_replaces_the_derived_one() -> None:
-    level = edit(DANXIAN, ("  - {from: 1680, to: 2400, per_mille: -8}\n", ""),
-                 ("  - {from: 0, to: 720, per_mille: 8}\n", ""))
+    level = edit(DANXIAN, ("  - {from: 1680, to: 2400, per_mille: 9}\n", ""),
+                 (f"  - {X_APPROACH}\n", ""))
     assert not any(r.overlap_sections for r in table(level).routes.values())
     own = DANXIAN + ("\noverlaps:\n  - {end_signal: XI, sections: [2DG], "
                      "turnouts: [{turnout: \"2\", position: normal}], release_s: 60}\n")

@@ -1,0 +1,42 @@
+"""A train route never runs through a station track (股道) out into the far throat: where a track has no train signal
+at its far end, the path through it is left out of the table with a design warning (a real table has no route that
+receives and departs in one, or leaves onto a line against its direction)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from liansuo.cli.main import main
+from liansuo.interlocking.table import build_table
+from liansuo.stations.loader import load
+
+ROOT = Path(__file__).resolve().parent.parent
+BROKEN = ROOT / "examples" / "broken" / "no-starting-signal.yaml"
+
+
+def test_a_home_signal_gets_no_route_through_a_track_without_its_starting_signal() -> None:
+    table = build_table(load(BROKEN))
+    assert not [r for r in table.routes.values() if r.signal == "X" and r.end == "XFK2"]
+    assert {r.id for r in table.routes.values() if r.signal == "X"} == {"X-XI"}
+    assert len(table.warnings) == 1
+    w = table.warnings[0]
+    assert w.severity == "warning" and "station track IIG has no down train signal at J-IIS" in w.message
+    assert "X to XFK2" in w.message and w.line > 1
+
+
+def test_check_and_table_print_the_warning(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["check", str(BROKEN)]) == 0
+    out = capsys.readouterr().out
+    assert "warnings     1" in out and "IIG has no down train signal at J-IIS" in " ".join(out.split())
+    assert main(["table", str(BROKEN)]) == 0
+    out, err = capsys.readouterr()
+    assert "IIG has no down train signal at J-IIS" in err
+    assert "XFK2" not in out.split("== 下行发车")[0]  # no receiving row from X that leaves by XFK2
+
+
+def test_the_bundled_and_example_stations_lose_no_route() -> None:
+    examples = sorted((ROOT / "examples" / "stations").glob("*.yaml"))
+    for name in ("jiaopei", "gaotie", "depot", *(str(p) for p in examples)):
+        assert build_table(load(name)).warnings == [], name
