@@ -67,6 +67,13 @@ class Index:
                                for p in st.model.platforms if p.screen_doors}
         self.autoblock = AutoBlock(st)
         self.interlocked = tuple(name for name, section in st.sections.items() if section.role in INTERLOCKED)
+        # signal -> the automatic lines a movement passing it comes from (the section in rear lies on the line)
+        line_of = {sec: lk.id for lk in st.model.links if lk.kind.value == "automatic" for sec in lk.sections}
+        self.receives_from: dict[str, str] = {}
+        for sig in st.signals:
+            rear = st.signal_rear_track(sig)
+            if rear is not None and st.tracks[rear].section in line_of:
+                self.receives_from[sig] = line_of[st.tracks[rear].section]
 
 
 class Core:
@@ -111,7 +118,7 @@ class Core:
         self.entry_section = index.entry_section
         self.signal_by_entry = index.signal_by_entry
         self.platform_doors = index.platform_doors
-        self._throat_platforms: dict[str, list[str]] = {}  # home signal -> platform tracks bordering its throat
+        self._guide_areas: dict[str, tuple[frozenset[str], frozenset[str]]] = {}  # home signal -> guide_area
         self._door_sections: dict[str, tuple[str, ...]] = {}  # route id -> door_sections(route)
         self.autoblock = index.autoblock
         self.codes_dirty = True
@@ -318,6 +325,8 @@ class Core:
         if any(rs.released):
             released = [s for i, s in enumerate(rs.sections) if rs.released[i]]
             return f"section {released[0]} of route {r.id} has been released: the route is no longer locked"
+        if rs.overlap_released and not guide:
+            return f"the overlap of route {r.id} has been released: the route is no longer locked"
         own = len(rs.turnouts)  # the route's own turnouts come first and must be locked by it; the overlap's after
         indication, held_by = self.board.indication, self.locks.held_by
         for i, t in enumerate(rs.all_turnouts):
@@ -368,6 +377,9 @@ class Core:
         return ""
 
     def liaison_blocker(self, r: Route) -> str:
+        why = self.line_against(r.signal)
+        if why:
+            return why
         if r.exit_link in self.links:
             link = self.links[r.exit_link]
             if link.state.value != "permitted":
@@ -414,29 +426,53 @@ class Core:
                     return f"screen doors {key} are not closed and locked (and not bypassed)"
         return ""
 
-    def guide_only_doors(self, signal: str) -> list[str]:
-        """The platform tracks a guided train may reach from ``signal`` under guide total lock, where the
-        interlocking does not know the way (a turnout may have been trailed through): every platform track that
-        borders the throat the signal leads into, whichever way its turnouts lie."""
-        if signal not in self._throat_platforms:
+    def guide_area(self, signal: str) -> tuple[frozenset[str], frozenset[str]]:
+        """Where a guided train may go from ``signal`` under guide total lock, where the interlocking does not know
+        the way (a turnout may have been trailed through): the sections of the throat the signal leads into, and
+        the tracks that border it (station tracks, spurs, the lines), whichever way its turnouts lie."""
+        area = self._guide_areas.get(signal)
+        if area is None:
             st = self.station
-            outside = (SectionRole.station_track, SectionRole.approach, SectionRole.block, SectionRole.departure)
+            outside = (SectionRole.station_track, SectionRole.approach, SectionRole.block, SectionRole.departure,
+                       SectionRole.spur)
             start = st.signal_entry_track(signal)
-            seen, todo, border = {start}, [start], []
+            seen, todo = {start}, [start]
+            throat, border = {st.tracks[start].section}, set()
             while todo:
                 track = todo.pop()
                 for port in st.track_ports[track]:
                     for _, nxt in st.node_tracks[port.node]:
                         sec = st.tracks[nxt].section
-                        if nxt in seen:
+                        if nxt in seen or nxt == st.signal_rear_track(signal):
                             continue
                         seen.add(nxt)
-                        if sec in self.platform_doors:
-                            border.append(sec)
-                        elif st.sections[sec].role not in outside:
+                        if st.sections[sec].role in outside:
+                            border.add(sec)
+                        else:
+                            throat.add(sec)
                             todo.append(nxt)
-            self._throat_platforms[signal] = sorted(set(border))
-        return self._throat_platforms[signal]
+            area = self._guide_areas[signal] = (frozenset(throat), frozenset(border))
+        return area
+
+    def guide_only_doors(self, signal: str) -> list[str]:
+        """The platform tracks a guided train may reach from ``signal`` under guide total lock: every platform track
+        that borders the throat the signal leads into (:meth:`guide_area`)."""
+        return sorted(s for s in self.guide_area(signal)[1] if s in self.platform_doors)
+
+    def guide_only_meets(self, signal: str, sections: Iterable[str], leads_into: str | None) -> bool:
+        """Would a route over ``sections`` (entering ``leads_into`` at sight) run into the train guided from
+        ``signal`` under guide total lock: into the throat it is guided over, or onto a track that borders it."""
+        throat, border = self.guide_area(signal)
+        return not throat.isdisjoint(sections) or not border.isdisjoint(sections) or leads_into in border
+
+    def line_against(self, signal: str) -> str:
+        """Why no movement may be received past ``signal``: the line it comes from has been set for departures
+        from this station (改方); '' when none is."""
+        link = self.index.receives_from.get(signal)
+        if link is not None and link in self.line_out:
+            return (f"line {link} is set for departures from this station (改方): signal {signal} receives no "
+                    f"train from it; 'line-direction {link} in' first")
+        return ""
 
     def door_sections(self, r: Route) -> tuple[str, ...]:
         """The platform tracks with screen doors the route runs over or starts from (the station's, so kept)."""

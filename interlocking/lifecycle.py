@@ -131,7 +131,12 @@ class RouteLifecycle:
             rs.standing_memo = SettingMemo(rs, il.cycles, self.reads(rs))
 
     def _locked(self, rs: RouteState) -> None:
-        """Locked, the signal not yet given: it opens as soon as every condition holds."""
+        """Locked, the signal not yet given: it opens as soon as every condition holds; a guide route gives the
+        guide aspect once what it checks holds (not its track circuits)."""
+        if rs.guide_route:
+            if not self.il.open_blocker(rs, guide=True):
+                self.open_guide(rs)
+            return
         if not self._entered_closed(rs) and not self.il.open_blocker(rs):
             self.open(rs)
 
@@ -290,6 +295,13 @@ class RouteLifecycle:
             if not rs.released[i] and not il.clear(s):
                 rs.was_occupied[i] = True
                 any_occupied = True
+        for i, due in list(rs.fault_release_at.items()):  # section fault releases given ahead of the movement
+            if rs.released[i] or rs.was_occupied[i]:
+                del rs.fault_release_at[i]  # released, or the movement reached it: it releases behind it
+            elif il.now >= due:
+                del rs.fault_release_at[i]
+                il.event("release", f"section {secs[i]} released by section fault release ({rs.id})")
+                self.release_section(rs, i)
         last = n - 1
         # a shunting movement that drew back out of its route (中途返回): nothing in the route occupied, the section
         # in rear of the signal occupied again; the sections it passed release without the next one occupied
@@ -412,9 +424,12 @@ class RouteLifecycle:
         rs.released = [True] * len(rs.released)
         il.locks.release(Hold.route, rs.id)
         il.locks.release(Hold.fouling, rs.id)
-        if r.overlap_sections:
-            if rs.overlap_release_at is not None and not all_sections:
-                il.overlap_pending[rs.id] = rs.overlap_release_at
+        if r.overlap_sections and not rs.overlap_released:
+            # the overlap is held on for its time after the train reached the receiving track, or for a section
+            # fault release given while the train ran in (whichever is later)
+            due = [at for at in (rs.overlap_release_at, il.overlap_pending.get(rs.id)) if at is not None]
+            if due and not all_sections:
+                il.overlap_pending[rs.id] = max(due)
             else:
                 self.release_overlap(rs.id)
         if il.out.signals.get(r.signal) != stop_aspect(il.station, r.signal):
@@ -433,9 +448,14 @@ class RouteLifecycle:
         self.il.event("release", f"overlap of {rid} released")
 
     def _overlaps(self) -> None:
+        now = self.il.now
         for rid, at in list(self.il.overlap_pending.items()):
-            if at is not None and self.il.now >= at:
+            rs = self.il.routes.get(rid)  # a route still in use: not before its own overlap time either
+            later = rs.overlap_release_at if rs is not None else None
+            if at is not None and now >= at and (later is None or now >= later):
                 self.release_overlap(rid)
+                if rs is not None:
+                    rs.overlap_released = True
 
     # ---- the guide aspect without a route (a throat under guide total lock) ---------------------------------
     def open_guide_only(self, signal: str) -> None:
@@ -500,4 +520,5 @@ class RouteLifecycle:
 def _look(rs: RouteState) -> tuple[object, ...]:
     """What a route's handler may change on the route itself (the rest it changes shows in :class:`~.quiet.Mark`)."""
     return (rs.stage, rs.since, rs.entered, rs.release_at, rs.overlap_release_at, rs.guide_first_clear,
-            rs.guide_approach_seen, tuple(rs.released), tuple(rs.was_occupied), rs.run_on)
+            rs.guide_approach_seen, tuple(rs.released), tuple(rs.was_occupied), rs.run_on, rs.overlap_released,
+            tuple(rs.fault_release_at.items()))

@@ -40,14 +40,9 @@ class Operator:
         if button not in st.signals[start].buttons:
             other = "shunt" if kind == "train" else "route"
             return Result.refuse(f"signal {start} has no {_KIND_WORD[kind]} button; use '{other} {start} ...'")
-        r = self.il.table.by_buttons(kind, start, end, via)
-        if r is None and via:  # the last button may be an overlap's end button
-            r = self.il.table.by_buttons(kind, start, via[-1], via[:-1], overlap=end)
+        r, why = self._find(kind, start, end, via)
         if r is None:
-            options = sorted(x.id for x in self.il.table.routes.values() if x.kind == kind and x.start == start)
-            return Result.refuse(f"no {_KIND_WORD[kind]} route from {start} to {end}"
-                                 + (" via " + ",".join(via) if via else "")
-                                 + (f"; routes from {start}: {', '.join(options)}" if options else ""))
+            return Result.refuse(why)
         run_on, why = self.choose_run_on(r)
         if not why:
             why = self.route_blocker(r, run_on)
@@ -55,6 +50,17 @@ class Operator:
             return Result.refuse(why)
         self.lifecycle.select(RouteState(r, RouteStage.setting, self.il.now, run_on=run_on))
         return Result.accept(f"route {r.id} selected")
+
+    def _find(self, kind: Kind, start: str, end: str, via: tuple[str, ...]) -> tuple[Route | None, str]:
+        """The route the buttons select, or why there is none."""
+        r = self.il.table.by_buttons(kind, start, end, via)
+        if r is None and via:  # the last button may be an overlap's end button
+            r = self.il.table.by_buttons(kind, start, via[-1], via[:-1], overlap=end)
+        if r is not None:
+            return r, ""
+        options = sorted(x.id for x in self.il.table.routes.values() if x.kind == kind and x.start == start)
+        return None, (f"no {_KIND_WORD[kind]} route from {start} to {end}" + (" via " + ",".join(via) if via else "")
+                      + (f"; routes from {start}: {', '.join(options)}" if options else ""))
 
     def choose_run_on(self, r: Route) -> tuple[RunOn | None, str]:
         """The way a shunting movement runs on past the end of ``r``, as the turnouts beyond lie; or why it cannot
@@ -69,12 +75,22 @@ class Operator:
         return None, (f"turnout {lost[0] if lost else '?'} beyond {r.end} has no indication: a shunting movement "
                       f"running on past {r.end} could go either way")
 
-    def route_blocker(self, r: Route, run_on: RunOn | None = None) -> str:
-        """Why ``r`` (running on over ``run_on``) may not be set now; '' when it may."""
+    def route_blocker(self, r: Route, run_on: RunOn | None = None, *, guide: bool = False) -> str:
+        """Why ``r`` (running on over ``run_on``) may not be set now; '' when it may. ``guide``: a guide route
+        (引导进路锁闭), locked without looking at the occupancy of its sections (a track circuit of it is faulty);
+        everything else is checked as for any route."""
         if self.il.power_up_locked:
             return "the station is locked since the interlocking started (上电锁闭): give the power-up release first"
         if r.signal in self.il.by_signal:
             return f"signal {r.signal} already has route {self.il.by_signal[r.signal]} set"
+        why = self.il.line_against(r.signal)
+        if why:
+            return why
+        leads_into = run_on.leads_into if run_on else r.leads_into
+        for sig in self.il.guide_only:
+            if self.il.guide_only_meets(sig, [*r.sections, *(run_on.sections if run_on else ())], leads_into):
+                return (f"the guide aspect of {sig} is lit under guide total lock (引导总锁闭): no route into its "
+                        "throat or onto a track it leads to until it closes")
         if r.exit_link in self.il.auto_links:
             why = self.il.against_running(r.exit_link)
             if why:
@@ -89,12 +105,14 @@ class Operator:
             for lk in self.il.locks.section_locks(s):
                 if lk.hold is Hold.fouling and s not in sections:
                     continue  # several routes may check the same fouling section
-                if lk.hold is Hold.overlap and lk.holder in self.il.routes and self._continues(lk.holder, r, s):
-                    continue  # the onward route of a through movement runs over the overlap
+                if lk.hold is Hold.overlap and self._continues(lk.holder, r, s):
+                    continue  # the onward route of a through movement runs over the overlap (held or timing)
+                if lk.hold is Hold.route and self._continues(r.id, self.il.table.routes.get(lk.holder), s):
+                    continue  # the departure of a through movement is set first: its route covers our overlap
                 if lk.hold is Hold.power_up:
                     return self.route_blocker_power_up(s)
                 return f"section {s} is locked {lk.words()}"
-            if not self.il.clear(s):
+            if not guide and not self.il.clear(s):
                 return f"section {s} is occupied"
         turnouts = r.all_turnouts + (run_on.turnouts if run_on else ())
         for t in turnouts:
@@ -104,7 +122,7 @@ class Operator:
                 if self.il.board.indication(member) == t.position.value:
                     continue
                 why = self.il.locks.why_turnout(member)
-                if why and not self._driven_there(member, t.position.value):
+                if why and not self._driven_there(member, t.position.value) and not self._beside_overlap(member, r):
                     return f"{why}; the route needs it {t.position.value}"
                 if not self.il.clear(self.il.turnouts[member].section):
                     return f"turnout {member} cannot move: section {self.il.turnouts[member].section} is occupied"
@@ -123,6 +141,19 @@ class Operator:
                 return False
         return bool(locks)
 
+    def _beside_overlap(self, turnout: str, r: Route) -> bool:
+        """Every lock on ``turnout`` comes from an overlap section of a route that ``r`` continues (a through
+        movement), and that overlap does not run over the turnout: the onward route may move it (as its flank
+        protection, say), since the overlap's way does not depend on it."""
+        locks = self.il.locks.turnout_locks(turnout)
+        for lk, via, partner in locks:
+            first = self.il.table.routes.get(lk.holder)
+            if lk.hold is not Hold.overlap or not via or first is None or not self._continues(first.id, r, via):
+                return False
+            if any(x.id in (turnout, partner) for x in first.overlap_turnouts):
+                return False
+        return bool(locks)
+
     def route_blocker_power_up(self, section: str) -> str:
         return f"section {section} is locked since the interlocking started (上电锁闭): give the power-up release first"
 
@@ -138,11 +169,13 @@ class Operator:
         """The turnouts lie as ``cond`` says (or cannot be told: fail-safe, it holds)."""
         return all(self.il.board.indication(t) in (p.value, None) for t, p in cond)
 
-    def _continues(self, rid: str, r: Route, section: str) -> bool:
-        """``r`` continues active route ``rid`` from its end signal in the same direction over its overlap."""
-        first = self.il.routes[rid].route
-        return (r.signal == first.end_signal and r.direction is first.direction
-                and section in first.overlap_sections and section not in first.sections)
+    def _continues(self, rid: str, r: Route | None, section: str) -> bool:
+        """``r`` continues route ``rid`` (set, or its overlap still timing) from its end signal in the same direction,
+        and ``section`` is in ``rid``'s overlap: a through movement, which is no enemy in either order of setting."""
+        first = self.il.table.routes.get(rid)
+        return (first is not None and r is not None and r.signal == first.end_signal
+                and r.direction is first.direction and section in first.overlap_sections
+                and section not in first.sections)
 
     def _still_conflicts(self, rs: RouteState, r: Route, run_on: RunOn | None) -> str:
         """What the active route ``rs`` still holds that ``r`` needs, in a signaller's words; '' when nothing.
@@ -250,23 +283,81 @@ class Operator:
         if not self.il.clear(section):
             return Result.refuse(f"section {section} is occupied: only a clear section can be released")
         if not routes:
-            rid = overlaps[0]
-            self.lifecycle.release_overlap(rid)
-            return Result.accept(f"overlap of {rid} released")
+            return self._fault_release_overlap(section, overlaps[0])
         rs = self.il.routes[routes[0]]
         if rs.stage in (RouteStage.open, RouteStage.guide):
             return Result.refuse(f"signal {rs.route.signal} is open over {section}: close it first (cancel)")
         if self.lifecycle.approach_locked(rs) and not rs.entered:
-            rules = self.il.rules
-            delay = rules.section_fault_release_s if rs.route.kind == "train" else rules.release_s["shunt"]
-            self.lifecycle.start_time_release(rs, delay, "section fault release")
-            self.il.event("route", f"section fault release of {section} with a train approaching: {delay:g} s")
-            return Result.accept(f"section {section} ({rs.id}) releases in {delay:g} s unless a train enters")
-        self.lifecycle.release_section(rs, rs.sections.index(section))
+            return self._fault_release_delayed(rs, section)
+        i = rs.sections.index(section)
+        if rs.entered and self._ahead_of_movement(rs, i):
+            if i in rs.fault_release_at:
+                return Result.refuse(f"section {section} ({rs.id}) is already being released "
+                                     f"({rs.fault_release_at[i] - self.il.now:.0f} s left)")
+            delay = self._fault_delay(rs.route)
+            rs.fault_release_at[i] = self.il.now + delay
+            self.il.event("route", f"section fault release of {section} ahead of the movement in {rs.id}: "
+                          f"{delay:g} s")
+            return Result.accept(f"section {section} ({rs.id}) releases in {delay:g} s unless the movement "
+                                 "reaches it: it is still on its way")
+        self.lifecycle.release_section(rs, i)
         self.il.event("release", f"section {section} released by section fault release")
         if all(rs.released):
             self.lifecycle.finish(rs, all_sections=False)
         return Result.accept(f"section {section} released")
+
+    def _ahead_of_movement(self, rs: RouteState, i: int) -> bool:
+        """Section ``i`` of a route in use lies ahead of a movement still on its way to it: the movement has not
+        reached it or anything beyond it, and stands in the route before it or in its approach."""
+        if any(rs.was_occupied[i:]):
+            return False
+        clear = self.il.clear
+        return any(not clear(s) for s in rs.sections[:i]) or any(not clear(s) for s in rs.route.approach)
+
+    def _fault_delay(self, r: Route) -> float:
+        rules = self.il.rules
+        return rules.section_fault_release_s if r.kind == "train" else rules.release_s["shunt"]
+
+    def _fault_release_delayed(self, rs: RouteState, section: str) -> Result:
+        """A section fault release with a train approaching the closed signal: the route releases after the delay,
+        everything still checked, unless the train enters (as a manual time release)."""
+        delay = self._fault_delay(rs.route)
+        self.lifecycle.start_time_release(rs, delay, "section fault release")
+        self.il.event("route", f"section fault release of {section} with a train approaching: {delay:g} s")
+        return Result.accept(f"section {section} ({rs.id}) releases in {delay:g} s unless a train enters")
+
+    def _fault_release_overlap(self, section: str, rid: str) -> Result:
+        """区故解 of a section locked only as the overlap (延续进路) of route ``rid``: as for a section of the route
+        itself, refused under the open signal and delayed with a train approaching or running in the route; an
+        overlap timing behind a train on the receiving track is never shortened."""
+        rs = self.il.routes.get(rid)
+        if rs is None:
+            at = self.il.overlap_pending.get(rid)
+            left = f" in {at - self.il.now:.0f} s" if at is not None else ""
+            return Result.refuse(f"section {section} is the overlap (延续进路) of {rid}, held for the train that "
+                                 f"was received: it releases by itself{left}; a section fault release cannot "
+                                 "shorten it")
+        signal = rs.route.signal
+        if rs.stage in (RouteStage.open, RouteStage.guide):
+            return Result.refuse(f"signal {signal} is open over {section} (the overlap of {rid}): close it first "
+                                 "(cancel)")
+        if rs.entered:
+            if rs.overlap_release_at is not None:
+                return Result.refuse(f"section {section} is the overlap (延续进路) of {rid}: it releases by itself "
+                                     f"in {rs.overlap_release_at - self.il.now:.0f} s after the train reached "
+                                     f"{rs.route.sections[-1]}; a section fault release cannot shorten it")
+            delay = self._fault_delay(rs.route)
+            self.il.overlap_pending[rid] = self.il.now + delay
+            self.il.event("route", f"section fault release of {section} (overlap of {rid}) with a train in the "
+                          f"route: {delay:g} s")
+            return Result.accept(f"section {section} (overlap of {rid}) releases in {delay:g} s, or later if the "
+                                 "train reaches the end of the route first")
+        if self.lifecycle.approach_locked(rs):
+            return self._fault_release_delayed(rs, section)
+        self.lifecycle.release_overlap(rid)
+        rs.overlap_released = True
+        return Result.accept(f"overlap of {rid} released; signal {signal} cannot open without it: cancel the route "
+                             "and set it again")
 
     def reopen(self, signal: str) -> Result:
         """重复开放: reopen a signal closed abnormally, once its conditions are back."""
@@ -285,8 +376,10 @@ class Operator:
         return Result.accept(f"signal {signal} reopened")
 
     # ---- guide ------------------------------------------------------------------------------------------------
-    def guide(self, signal: str) -> Result:
-        """引导: open HB over a set route without checking its track circuits, or over a guide-locked throat."""
+    def guide(self, signal: str, end: str | None = None, via: tuple[str, ...] = ()) -> Result:
+        """引导: open HB over a set route without checking its track circuits, or over a guide-locked throat. With
+        ``end`` (and variant buttons ``via``): a guide route (引导进路锁闭), selected and locked without looking at its
+        track circuits, the guide aspect given once its turnouts are in position."""
         st = self.il.station
         if signal not in st.signals:
             return Result.refuse(f"there is no signal '{signal}' at {st.id}")
@@ -299,6 +392,8 @@ class Operator:
         if not self.il.board.lamp_ok(signal, stop_aspect(st, signal)):
             return Result.refuse(f"the red lamp of {signal} is dark: the guide aspect needs it lit")
         rs = self.il.route_of(signal)
+        if end is not None:
+            return self._guide_route(signal, end, via, rs)
         if rs is not None:
             if rs.stage not in (RouteStage.setting, RouteStage.locked, RouteStage.closed) or rs.entered:
                 return Result.refuse(f"route {rs.id} is {rs.stage.value}; a guide route needs a locked route "
@@ -317,11 +412,46 @@ class Operator:
         if throat is None:
             return Result.refuse(f"no route is set from {signal} and its throat is not under guide total lock: "
                                  f"set the route first, or 'guide-lock {signal}'")
+        why = self.il.line_against(signal)
+        if why:
+            return Result.refuse(f"guide refused: {why}")
+        inside, beside = self.il.guide_area(signal)
+        for sec in sorted(inside | beside):  # the way is not known: nothing may be locked where the train may go
+            holders = self.il.locks.section_holders(sec)
+            if holders:
+                return Result.refuse(f"guide refused: section {sec}, where a train guided past {signal} may run, is "
+                                     f"locked in route {holders[0]}")
+        for rs in self.il.routes.values():  # nor may a shunting movement run into a track it may reach, at sight
+            ro = rs.run_on
+            if self.il.guide_only_meets(signal, (), ro.leads_into if ro else rs.route.leads_into):
+                return Result.refuse(f"guide refused: route {rs.id} leads into a track a train guided past {signal} "
+                                     "may reach")
+        for other in self.il.guide_only:  # nor may another guided train, from the other end
+            if self.il.guide_only_meets(other, inside | beside, None):
+                return Result.refuse(f"guide refused: the guide aspect of {other} is lit under guide total lock, "
+                                     f"towards the tracks {signal} leads to")
         doors = self.il.doors_blocker(self.il.guide_only_doors(signal))
         if doors:  # the way is not known: every platform track the signal leads to must have its doors safe
             return Result.refuse(f"guide refused: {doors}")
         self.lifecycle.open_guide_only(signal)
         return Result.accept(f"guide aspect {guide} on {signal} (guide total lock)")
+
+    def _guide_route(self, signal: str, end: str, via: tuple[str, ...], rs: RouteState | None) -> Result:
+        if rs is not None:
+            return Result.refuse(f"signal {signal} already has route {rs.id} set: give 'guide {signal}' over it, or "
+                                 "cancel it first")
+        r, why = self._find("train", signal, end, via)
+        if r is None:
+            return Result.refuse(f"guide refused: {why}")
+        if r.category != "receiving" and self.il.station.signals[signal].kind is not SignalKind.route:
+            return Result.refuse(f"guide refused: {r.id} is not a receiving route")
+        why = self.route_blocker(r, guide=True)
+        if why:
+            return Result.refuse(f"guide refused: {why}")
+        self.lifecycle.select(RouteState(r, RouteStage.setting, self.il.now, guide_route=True))
+        self.il.event("route", f"guide route {r.id} selected (引导进路锁闭): its track circuits are not checked")
+        return Result.accept(f"guide route {r.id} selected: {self.il.rules.aspects.guide} on {signal} once its "
+                             "turnouts are in position")
 
     def _guide_locked(self, turnout: str, throat: str) -> bool:
         return any(lk.hold is Hold.guide and lk.holder == throat for lk, _, _ in self.il.locks.turnout_locks(turnout))
@@ -435,11 +565,16 @@ class Operator:
         if occupied:
             return Result.refuse(f"line {link} is not clear ({', '.join(occupied)} occupied): the direction changes "
                                  "only with the whole line clear")
+        receiving = [sig for sig, line in self.il.index.receives_from.items() if line == link]
         for rs in self.il.routes.values():
             r = rs.route
-            if r.exit_link == link or set(r.approach) & set(lk.sections):
+            if r.exit_link == link or set(r.approach) & set(lk.sections) or r.signal in receiving:
                 return Result.refuse(f"route {r.id} uses line {link}: the direction changes only with no route "
                                      "into or out of it")
+        guided = [sig for sig in receiving if sig in self.il.guide_only]
+        if guided:
+            return Result.refuse(f"signal {guided[0]} shows the guide aspect for a train from line {link}: the "
+                                 "direction changes only with no signal given for a movement on the line")
         if want_out:
             self.il.line_out.add(link)
             self.il.out.line_direction[link] = "outbound"

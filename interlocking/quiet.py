@@ -5,7 +5,8 @@ A cycle is a function of the interlocking's state, its relay inputs and the time
 (no relay changed before it, every route's cycle was skipped by its memo or waited without a change, the turnouts,
 lines, alarms, events, locks and outputs stayed as they were), the next cycle starts from the same state with the
 same relays, so it changes nothing either, unless one of the time conditions read in a cycle turns: a turnout's
-move time-out, the squeeze alarm of a turnout without indication, a time release, an overlap's release time. A
+move time-out, the squeeze alarm of a turnout without indication, a time release, a section fault release
+counting down, an overlap's release time. A
 :class:`Quiet` keeps those conditions, asked with the very rules the cycle asks (``TurnoutState.move_timed_out``,
 ``squeeze_due``, ``Core.squeeze_watched``), and
 :meth:`~.cbi.Interlocking.cycle` runs no cycle while it holds (it only moves the clock and the cycle count).
@@ -80,5 +81,6 @@ def quiet_after(core: Core, before: Mark, changes: Changes, routes_settled: bool
     due = [at for at in core.overlap_pending.values() if at is not None]
     due += [rs.release_at for rs in core.routes.values()
             if rs.stage is RouteStage.time_release and rs.release_at is not None]
+    due += [at for rs in core.routes.values() for at in rs.fault_release_at.values()]
     return Quiet(moves, core.rules.turnout_timeout_s, tuple(core.squeeze_watched()), core.rules.squeeze_alarm_s,
                  tuple(due))

@@ -35,6 +35,10 @@ class RouteState:
     overlap_release_at: float | None = None  # when the overlap releases, once the train reached the route's end
     guide_first_clear: bool = False  # under a guide aspect: the first section was clear when it opened
     guide_approach_seen: bool = False  # under a guide aspect: the guided train has been seen approaching
+    # section index -> when its section fault release (区故解) completes, given ahead of the movement in the route
+    fault_release_at: dict[int, float] = field(default_factory=dict)
+    guide_route: bool = False  # a guide route (引导进路锁闭): locked without its track circuits, opens only HB
+    overlap_released: bool = False  # its overlap was released by section fault release before the signal was given
     # in use: what the last release check saw, so that a cycle in which none of it changed skips it (lifecycle)
     release_memo: ReleaseMemo | None = field(default=None, repr=False, compare=False)
     # setting or open: what the last look at its turnouts, or at its open signal's conditions, read (lifecycle)
@@ -90,7 +94,8 @@ class ReleaseMemo:
     def holds(self, rs: RouteState, cycle: int, changed: set[str]) -> bool:
         """Nothing the check reads changed since it last ran, with ``changed`` the track relays that changed in
         ``cycle``."""
-        return (self.cycle == cycle - 1 and self.watched.isdisjoint(changed) and rs.released == self.released
+        return (self.cycle == cycle - 1 and not rs.fault_release_at and self.watched.isdisjoint(changed)
+                and rs.released == self.released
                 and rs.was_occupied == self.was_occupied and rs.overlap_release_at == self.overlap_release_at
                 and rs.run_on is self.run_on and rs.route is self.route)
 

@@ -28,7 +28,7 @@ USAGE = {
     "release": "release SIGNAL",
     "fault-release": "fault-release SECTION",
     "reopen": "reopen SIGNAL",
-    "guide": "guide SIGNAL",
+    "guide": "guide SIGNAL [END [VIA ...]]",
     "guide-lock": "guide-lock THROAT",
     "guide-unlock": "guide-unlock THROAT",
     "throw": "throw TURNOUT normal|reverse",
@@ -86,6 +86,16 @@ def _one(name: str, fn: Callable[[World, str], Result]) -> Handler:
         return fn(sim, args[0])
 
     return handler
+
+
+def _guide(sim: World, args: list[str]) -> Result:
+    """引导 over the route set from the signal (or a throat under guide total lock); with an end button, a guide
+    route (引导进路锁闭): ``guide START [VIA ...] END``, as a route's buttons."""
+    if not args:
+        return Result.refuse(f"usage: {USAGE['guide']}")
+    if len(args) == 1:
+        return sim.interlocking.operator.guide(args[0])
+    return sim.interlocking.operator.guide(args[0], args[-1], tuple(args[1:-1]))
 
 
 def _throw(sim: World, args: list[str]) -> Result:
@@ -255,7 +265,7 @@ _HANDLERS: dict[str, Handler] = {
     "fault-release": _sealed("fault-release",
                              _one("fault-release", lambda s, a: s.interlocking.operator.fault_release(a))),
     "reopen": _one("reopen", lambda s, a: s.interlocking.operator.reopen(a)),
-    "guide": _sealed("guide", _one("guide", lambda s, a: s.interlocking.operator.guide(a))),
+    "guide": _sealed("guide", _guide),
     "guide-lock": _sealed("guide-lock",
                           _one("guide-lock", lambda s, a: s.interlocking.operator.guide_lock(a, True))),
     "guide-unlock": _one("guide-unlock", lambda s, a: s.interlocking.operator.guide_lock(a, False)),

@@ -253,10 +253,28 @@ async def test_lost_indication_flashes_the_turnout_red_and_guide_asks_for_confir
         assert "#ff2020" in colours or "#ffffff" in colours
         await pilot.press("g")
         await click(pilot, Ref("button", "X", "train"))
+        assert "引导进路 guide route from X" in message(app)  # no route set: the guide route, by its end button
+        await click(pilot, Ref("button", "XI", "train"))
         assert isinstance(app.screen, ConfirmScreen)
         await pilot.press("n")
         await pilot.pause()
         assert "not sent" in message(app)
+
+
+@run
+async def test_a_guide_route_over_a_red_band_is_set_by_its_buttons() -> None:
+    app = ConsoleApp("jiaopei", paused=True)
+    async with app.run_test(size=SIZE) as pilot:
+        app.send("occupy IG", "instructor")
+        cycles(app, 1)
+        await pilot.press("g")
+        await click(pilot, Ref("button", "X", "train"))
+        await click(pilot, Ref("button", "XI", "train"))
+        assert isinstance(app.screen, ConfirmScreen)
+        await pilot.press("y")
+        await pilot.pause()
+        cycles(app, 60)
+        assert app.sim.aspect("X") == "HB" and app.sim.sealed_uses().get("guide") == 1
 
 
 @run

@@ -86,7 +86,8 @@ class Operator:
     def pressed(self) -> set[Ref]:
         out: set[Ref] = set()
         if self.start is not None:
-            out.add(Ref("button", *self.start))
+            sig, kind = self.start
+            out.add(Ref("button", sig, "train" if kind == "guide" else kind))  # a guide route starts at L
             out |= {self._button_ref(b) for b in self.via}
         return out
 
@@ -98,7 +99,8 @@ class Operator:
         if self.mode is not None:
             return f"{self.mode.zh} {self.mode.en}: choose the {self.mode.target} (Esc cancels)"
         if self.start is not None:
-            kind = "列车进路 train route" if self.start[1] == "train" else "调车进路 shunting route"
+            kind = {"train": "列车进路 train route", "shunt": "调车进路 shunting route",
+                    "guide": "引导进路 guide route"}[self.start[1]]
             via = f" via {' '.join(self.via)}" if self.via else ""
             return f"{kind} from {self.start[0]}{via}: press the end button (Esc cancels)"
         return ""
@@ -184,6 +186,10 @@ class Operator:
         if not target:
             return Outcome(message=why)
         template = mode.template
+        if mode.name == "guide" and self._guide_route_first(target):
+            # no route set and the throat not under guide total lock: the guide route is chosen by its buttons
+            self.start, self.via = (target, "guide"), []
+            return Outcome(message=self.prompt())
         if mode.name == "guide-lock":
             turnouts = self.sim.table.throats.get(target, ())
             if turnouts and all(self.sim.turnout_mark(t) == "guide" for t in turnouts):
@@ -191,6 +197,15 @@ class Operator:
         command = template.format(target)
         question = f"{mode.zh} ({mode.en}): {command}?" if mode.confirm else ""
         return Outcome(command=command, confirm=question)
+
+    def _guide_route_first(self, signal: str) -> bool:
+        """引导 on a signal with no route set and its throat not under guide total lock: a guide route (引导进路锁闭)
+        is selected by its end button, as a train route is."""
+        if any(r.signal == signal and r.state != "released" for r in self.sim.view.routes()):
+            return False
+        turnouts = self.sim.table.throats.get(signal, ())
+        locked = bool(turnouts) and all(self.sim.turnout_mark(t) == "guide" for t in turnouts)
+        return not locked and any(r.kind == "train" and r.start == signal for r in self.sim.table.routes.values())
 
     def _target(self, mode: Mode, ref: Ref) -> tuple[str, str]:
         st = self.sim.station
@@ -220,8 +235,8 @@ class Operator:
             self.start, self.via = (ref.id, ref.sub), []
             return Outcome(message=self.prompt())
         start, kind_word = self.start
-        kind: Literal["train", "shunt"] = "train" if kind_word == "train" else "shunt"
-        if (ref.id, ref.sub) == self.start:
+        kind: Literal["train", "shunt"] = "shunt" if kind_word == "shunt" else "train"
+        if ref.id == start and ref.sub in (kind_word, "train" if kind_word == "guide" else kind_word):
             self.reset()
             return Outcome(message="route selection dropped")
         table = self.sim.table
@@ -230,6 +245,11 @@ class Operator:
                 and len(r.via) > len(self.via) and r.via[len(self.via)] == ref.id for r in table.routes.values()):
             self.via.append(ref.id)
             return Outcome(message=self.prompt())
-        words = ["route" if kind == "train" else "shunt", start, *self.via, ref.id]
+        word = {"train": "route", "shunt": "shunt", "guide": "guide"}[kind_word]
+        words = [word, start, *self.via, ref.id]
         self.reset()
+        if word == "guide":  # a sealed button: counted, and asked before it is given
+            n = self.sim.sealed_uses().get("guide", 0)
+            return Outcome(command=" ".join(words), confirm=f"引导 (guide, sealed button 铅封, used {n} time"
+                                                            f"{'' if n == 1 else 's'}): {' '.join(words)}?")
         return Outcome(command=" ".join(words))
