@@ -220,14 +220,28 @@ def test_a_relay_flasher_failing_silently_is_a_hazard_an_electronic_one_is_answe
     assert electronic.violations == []
 
 
-def test_guided_movements_under_guide_total_lock_are_the_operators_to_answer_for() -> None:
-    # under guide total lock the interlocking checks no route by design: the operator answers for both guides
-    locked = run_lines(DANXIAN, "guide-lock X", "guide-lock S", "guide X", "guide S", "run 2s")
-    assert locked.violations == [] and any(h.prop == "shared" and "IG" in h.text for h in locked.hazards)
-    # once the throats are unlocked again, the same meeting is the interlocking's (here one that forgets enemies)
-    unlocked = run_lines("jiaopei", "guide-lock X", "guide-unlock X", "route X XI", "shunt D2 XI", "run 10s",
-                         mutant="no-head-on-enemies")
-    assert "head-on" in props(unlocked)
+def test_a_guide_aspect_is_an_authority_like_any_other() -> None:
+    # two guide aspects under guide total lock towards the same tracks: the interlocking refuses the second
+    sim = Simulation(DANXIAN)
+    locked = Watch(sim)
+    refused = [line for line in ("guide-lock X", "guide-lock S", "guide X", "guide S", "run 2s")
+               if not sim.command(line).ok]
+    assert locked.violations == [] and refused == ["guide S"]
+    # an interlocking that lets them both be given is caught: two signals given at once are its own doing
+    both = run_lines(DANXIAN, "guide-lock X", "guide-lock S", "guide X", "guide S", "run 2s", mutant="guide-blind")
+    assert any(v.prop == "shared" and "IG" in v.text for v in both.violations)
+
+
+def test_a_guide_aspect_under_guide_total_lock_waits_for_the_overlap_of_a_received_train() -> None:
+    # the train received onto IG stands there, its overlap 2DG held beyond XI for an overrun: a guide aspect from
+    # the other end, whose train would run into that overlap, is refused until the overlap has released
+    lines = ("route X XI", "run 5s", "occupy IAG", "run 1s", "occupy 1DG", "run 1s", "vacate IAG", "occupy IG",
+             "run 1s", "vacate 1DG", "run 1s", "guide-lock S", "guide S", "run 181s", "guide S", "run 2s")
+    sim = Simulation(DANXIAN)
+    watch = Watch(sim)
+    refused = [line for line in lines if not sim.command(line).ok]
+    assert refused == ["guide S"] and sim.aspect("S") == "HB"
+    assert watch.violations == []
 
 
 # ---- the rules, stated on their own ----------------------------------------------------------------------------------

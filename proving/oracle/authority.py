@@ -8,7 +8,8 @@ Where an authority ends:
 
 - a **train** runs to the next train signal (home, starting, route or block) facing the same way, a buffer stop or
   the boundary of the station model; shunting signals on the way do not govern it. Where the station file asks for
-  an overlap (延续进路) beyond that signal, the overlap's sections and turnouts belong to the authority too.
+  an overlap (延续进路) beyond that signal, or a train received past a home signal on a steep falling approach needs
+  one (:mod:`.gradient`), the overlap's sections and turnouts belong to the authority too.
 - a **shunting** movement runs to the next signal facing the same way, a buffer stop, or the station limit (a home
   signal faced from inside). Signals facing the other way do not stop it: where a shunting route ends at one, the
   movement goes past it to reverse, and nothing on the track tells how far. Where it enters a station track or a
@@ -22,10 +23,11 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Literal
 
+from liansuo.rules import RuleSet
 from liansuo.stations.schema import Direction, SectionRole, SignalKind
 from liansuo.stations.station import Station
 
-from .gradient import steep_overlaps
+from .gradient import Overlap, beyond, steep_homes
 
 Kind = Literal["train", "shunt"]
 Lies = Callable[[str], "str | None"]  # turnout -> where its switch rails lie ('normal', 'reverse' or None)
@@ -78,28 +80,25 @@ class Authority:
 class Tracer:
     """Traces authorities over one station."""
 
-    def __init__(self, station: Station, *, overlap_release_s: float = 0.0,
-                 overlap_gradient_per_mille: float | None = None) -> None:
+    def __init__(self, station: Station, *, overlap_release_s: float = 0.0, rules: RuleSet | None = None) -> None:
         """``overlap_release_s``: the rule set's overlap release time, for an overlap whose station file gives none
-        (only an oracle that times overlaps needs it); ``overlap_gradient_per_mille``: the fall beyond an end signal
-        that calls for an overlap where the file gives none (None: only the file's overlaps)."""
+        (only an oracle that times overlaps needs it); ``rules``: the rule set whose data says where a falling
+        approach calls for an overlap beyond the receiving track (None: only the file's overlaps)."""
         self.st = station
         self.overlap_release_s = overlap_release_s
         self.topo = station.topology
         self.role = {s: sec.role for s, sec in station.sections.items()}
         self.section_of = {t: tr.section for t, tr in station.tracks.items()}
         self.link_at = {lk.end: lk.id for lk in station.model.links}
-        # end signal -> its overlaps (sections, turnout lie, release time); alternatives after the basic one
+        # home signals on a steep falling approach: their trains need an overlap beyond the receiving track
+        self.steep = steep_homes(station, rules) if rules is not None else set()
+        self._beyond: dict[str, Overlap | None] = {}
+        # end signal -> the file's own overlaps (sections, turnout lie, release time); alternatives after the basic
         self.overlaps: dict[str, list[tuple[tuple[str, ...], dict[str, str], float]]] = {}
-        if overlap_gradient_per_mille is not None:
-            for end, (sections, lie) in steep_overlaps(station, overlap_gradient_per_mille).items():
-                self.overlaps[end] = [(sections, lie, overlap_release_s)]
-        own: dict[str, list[tuple[tuple[str, ...], dict[str, str], float]]] = {}
-        for o in station.model.overlaps:  # the file's own overlaps replace one the profile calls for
-            own.setdefault(o.end_signal, []).append((
+        for o in station.model.overlaps:
+            self.overlaps.setdefault(o.end_signal, []).append((
                 tuple(o.sections), {t.turnout: t.position.value for t in o.turnouts},
                 o.release_s if o.release_s is not None else overlap_release_s))
-        self.overlaps.update(own)
         # the port of a track at a turnout: (track, turnout) -> leg
         self.leg_at: dict[tuple[str, str], str] = {}
         for tid, ports in station.track_ports.items():
@@ -155,6 +154,13 @@ class Tracer:
             chosen = next((o for o in options if all(lies(t) == p for t, p in o[1].items())), options[0])
             a.overlap_sections, turnouts, a.overlap_release_s = chosen
             a.overlap_turnouts = dict(turnouts)
+        elif kind == "train" and a.end == "signal" and signal in self.steep and a.end_signal is not None:
+            if a.end_signal not in self._beyond:
+                self._beyond[a.end_signal] = beyond(self.st, a.end_signal)
+            found = self._beyond[a.end_signal]
+            if found is not None:  # an overlap, or a safety line's turnout (no sections)
+                a.overlap_sections, a.overlap_turnouts = found[0], dict(found[1])
+                a.overlap_release_s = self.overlap_release_s
         return a
 
     def _add(self, a: Authority, track: str) -> None:

@@ -21,7 +21,7 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 
 from liansuo.rules import RuleSet
-from liansuo.stations.schema import SectionRole, SignalKind
+from liansuo.stations.schema import Direction, SectionRole, SignalKind
 from liansuo.stations.station import Station
 
 from .authority import Authority, Tracer
@@ -66,6 +66,7 @@ class _Held(Extent):
 
     unsettled: bool = False  # a turnout of it is not where it should be (the world's doing, being answered)
     operator: bool = False  # a guide aspect over turnouts without indication: the operator answers for the route
+    in_use: bool = False  # a movement under way (its signal has closed behind it)
 
 
 class Tables:
@@ -75,8 +76,7 @@ class Tables:
     is the one piece each oracle has of its own (``Flank.fresh``): its memo is keyed by a path's tracks alone."""
 
     def __init__(self, station: Station, rules: RuleSet) -> None:
-        self.tracer = Tracer(station, overlap_release_s=rules.overlap_release_s,
-                             overlap_gradient_per_mille=rules.overlap_gradient_per_mille)
+        self.tracer = Tracer(station, overlap_release_s=rules.overlap_release_s, rules=rules)
         self.flank = Flank(station, clearance_m(station, rules))
         self.reader = LampReader(rules.aspects)
         self.ceiling = Ceiling(station, rules)
@@ -94,6 +94,14 @@ class Tables:
         self.turnout_sections = sorted(set(self.turnout_section.values()))  # each once (a crossover's share one)
         self.turnout_tracks = {t: {tid for _, tid in station.node_tracks[t]} for t in station.turnouts}
         self.pair_of = {t.id: t.pair for t in station.model.turnouts if t.pair}
+        # automatic lines: their sections, and the direction that leads out of the station onto them
+        self.lines: dict[str, tuple[frozenset[str], Direction]] = {}
+        for lk in station.model.links:
+            if lk.kind.value == "automatic" and lk.sections:
+                first = station.section_tracks[lk.sections[0]]
+                inside = sum(station.node_at(p.node) for t in first for p in station.track_ports[t]) / (2 * len(first))
+                out = Direction.down if station.node_at(lk.end) > inside else Direction.up
+                self.lines[lk.id] = (frozenset(lk.sections), out)
 
 
 class Oracle:
@@ -118,6 +126,7 @@ class Oracle:
         self.turnout_sections = tables.turnout_sections
         self.turnout_tracks = tables.turnout_tracks
         self.pair_of = tables.pair_of
+        self.lines = tables.lines
         # what the oracle remembers between checks
         self.open: dict[str, Authority] = {}  # signal -> its authority at the last check
         self.shown: dict[str, str] = {}  # signal -> the proceed aspect it showed at the last check
@@ -169,6 +178,7 @@ class Oracle:
         for sig, aspect in shown.items():
             a = self.open[sig]
             held.append(self._judge_open(sig, aspect, a, view, shown, found))
+        self._lines(held, view, found)
         held += self._in_use(view)
         self.fault_released &= {s for u in self.in_use for s in u.sections}  # the movement's authority is gone
         self._across(held, found)
@@ -439,7 +449,7 @@ class Oracle:
             turnouts = {t: p for t, p in a.turnouts.items() if self.turnout_section.get(t) in rem}
             h = _Held(f"{a.signal} (in use)", a, rem | (set(a.overlap_sections) if overlap_held else set()), rem,
                       set(a.overlap_sections) if overlap_held else set(),
-                      {d for t in tracks for d, _ in self.st.crossings.get(t, ())}, operator=u.operator)
+                      {d for t in tracks for d, _ in self.st.crossings.get(t, ())}, operator=u.operator, in_use=True)
             for t, p in turnouts.items():
                 h.needed[t] = (p, "path")
             if overlap_held:
@@ -466,7 +476,10 @@ class Oracle:
             a, b = held[i], held[j]
             if a.auth is b.auth:
                 continue
-            hazard, delayed = a.operator or b.operator, a.unsettled or b.unsettled
+            # a guided movement the operator answers for (its track circuits unchecked) meeting a movement already
+            # under way is the operator's; two signals given at once, guided or not, are the interlocking's
+            hazard = (a.operator and b.in_use) or (b.operator and a.in_use)
+            delayed = a.unsettled or b.unsettled
             # where the operator released a section of one of them by hand, what follows is on the operator's word
             hazard = hazard or bool(self.fault_released & {*a.sections, *b.sections})
             for element in shared(a, b):
@@ -478,6 +491,27 @@ class Oracle:
                 key = f"head-on:{track}:{a.name}:{b.name}"
                 found[key] = Finding(key, "head-on", f"{a.name} ({a.auth.kind}) and {b.name} ({b.auth.kind}) lead "
                                      f"head-on onto {track}", hazard=hazard, delayed=delayed)
+
+    def _lines(self, held: list[_Held], view: FieldView, found: dict[str, Finding]) -> None:
+        """An automatic line is worked one way at a time: no signal may give a train out onto it while another gives
+        one in from it (a home or block signal facing the station, its section in rear on the line, route or guide
+        aspect alike), nor receive a train from it while its direction is set for departures (改方). A shunting
+        movement from the line's first section into the station is judged by the sections it shares."""
+        for link, (sections, out) in self.lines.items():
+            leaving = [h.name for h in held if h.auth.kind == "train" and h.auth.direction is out
+                       and not sections.isdisjoint(h.auth.sections)]
+            coming = [h.name for h in held if h.auth.kind == "train" and h.auth.direction is not out
+                      and self.rear[h.auth.signal] in sections]
+            if not coming:
+                continue
+            key = f"line:{link}"
+            if leaving:
+                found[key] = Finding(key, "line", f"signal {leaving[0]} gives a movement out onto line {link} while "
+                                     f"signal {coming[0]} gives one in from it: they run at each other on the line",
+                                     delayed=True)
+            elif view.line_outbound(link):  # the block signals follow a direction change a cycle later
+                found[key] = Finding(key, "line", f"line {link} is set for departures from this station (改方) while "
+                                     f"signal {coming[0]} gives a movement in from it", delayed=True)
 
     def _moving(self, view: FieldView, held: list[_Held], found: dict[str, Finding]) -> None:
         moving = {t: view.target(t) for t in view.moving()}

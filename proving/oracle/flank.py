@@ -11,7 +11,8 @@ the other way: it lies as its partner does (at a double slip, the partners of th
 onto the other straight road, which crosses it at the diamond).
 
 A section just beyond a joint on a free leg, where the fouling point (警冲标) lies beyond that joint, is a fouling
-section: a vehicle standing there fouls the path, so it must be clear.
+section: a vehicle standing there fouls the path, so it must be clear. So is the section of a track that crosses the
+path at a diamond: a vehicle standing on the crossing stands in the path.
 """
 
 from __future__ import annotations
@@ -109,6 +110,10 @@ class Flank:
                 fouling.append(sec)
         for x in sorted(crossing):
             dia = next(d for p in path for d, o in st.crossings.get(p, ()) if o == x)
+            # a vehicle standing on the crossing track fouls the path at the diamond: its section must be clear
+            sec = st.tracks[x].section
+            if sec not in fouling and not any(st.tracks[p].section == sec for p in path):
+                fouling.append(sec)
             for port in st.track_ports[x]:
                 if port.leg is not None:
                     found: tuple[str, str] | None = (port.node, port.leg)

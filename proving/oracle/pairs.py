@@ -37,7 +37,7 @@ class RouteSpec:
 class PaperOracle:
     def __init__(self, station: Station, rules: RuleSet) -> None:
         self.st = station
-        self.tracer = Tracer(station, overlap_gradient_per_mille=rules.overlap_gradient_per_mille)
+        self.tracer = Tracer(station, rules=rules)
         self.flank = Flank(station, clearance_m(station, rules))
         self.enemies = [frozenset(pair) for pair in rules.enemy_onto_track]
         self.partners: dict[str, list[str]] = {}
