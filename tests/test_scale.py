@@ -152,7 +152,8 @@ def test_the_plan_covers_the_table_with_batches_and_counts_every_pair() -> None:
                         and b.id not in a.conditional and a.id not in b.conditional)
     assert proved == compatible
     assert len(batches) < len(compatible)  # batches prove several pairs at once
-    assert [u.item for u in work.units if u.kind == "station"] == ["throats", "power-up", "red-lamp-transfer"]
+    assert [u.item for u in work.units if u.kind == "station"] == ["throats", "power-up", "red-lamp-transfer",
+                                                                   "line-direction", "guide-area"]
 
 
 def _pair_units_by_scanning(table: InterlockingTable, focus: set[str] | None) -> tuple[list[tuple[str, ...]], list[

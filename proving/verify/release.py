@@ -10,7 +10,8 @@ from liansuo.interlocking.aspects import is_open
 from liansuo.interlocking.table import Route
 from liansuo.stations.schema import Link, SignalKind
 
-from .probe import Context, Failure, Probe, against_running, open_route, other, route_line
+from .lines import reach
+from .probe import Context, Failure, Probe, against_running, open_route, other, prepare, route_line
 from .routecheck import RouteCheck
 
 
@@ -27,7 +28,9 @@ class ReleaseChecks:
         self.normal_release()
         self.flicker()
         self.fault_release()
+        self.overlap_fault_release()
         self.guide()
+        self.guide_route()
         self.lamps()
         self.doors()
         self.aspects()
@@ -182,6 +185,7 @@ class ReleaseChecks:
                           f"{result.message}", p)
             if result.ok:
                 p.do(f"cancel {o.signal}")
+        self.through_while_held(p)
         p.run(r.overlap_release_s - 3.0)
         held = [s for s in r.overlap_sections if p.sim.section_state(s) != "locked"]
         if not self.rt.check(not held, "overlap", f"overlap released early ({', '.join(held)}), before its "
@@ -193,9 +197,67 @@ class ReleaseChecks:
         self.rt.check(not held, "overlap", f"{r.overlap_release_s:g} s after the train stopped the overlap still "
                       f"holds {', '.join(held)}", p)
 
+    def through_while_held(self, p: Probe) -> None:
+        """With the train on the receiving track and the overlap held for it, each onward departure that continues
+        over the overlap in the same direction (the train's own departure) may be set: it is no enemy. Tried on a
+        copy of the run so far (the same lines on a fresh probe), so the overlap's own timer is judged untouched."""
+        r = self.r
+        onward = [o for o in self.ctx.table.routes.values() if o.kind == "train" and o.signal == r.end_signal
+                  and o.direction is r.direction and o.id not in r.conflicts]
+        for o in onward[:2]:
+            q = Probe(self.ctx)
+            for line in p.script():
+                if line.startswith("run "):
+                    q.run(_seconds(line))
+                else:
+                    q.do(line)
+            prepare(q, o)
+            result = q.do(route_line(o))
+            q.until(partial(q.is_open, o.signal), 40.0)
+            self.rt.check(result.ok and q.is_open(o.signal), "overlap", f"'{route_line(o)}' continuing over the "
+                          f"overlap of {r.id} while it is held for the train: {result.message}; {q.blocker(o)}", q)
+
+    def overlap_fault_release(self) -> None:
+        """Section fault release (区故解) of an overlap section, as of any section the route locks: refused while the
+        signal is open (its overlap turnouts stay locked), delayed by the rule set's time with a train running in,
+        and at once while no train comes."""
+        r = self.r
+        if not r.overlap_sections:
+            return
+        p = Probe(self.ctx)
+        if not self.rt.opened(p, "opens"):
+            return
+        for a in r.approach:
+            p.do(f"occupy {a}")
+        p.run(1.0)
+        for s in r.overlap_sections:
+            result = p.do(f"fault-release {s}")
+            p.run(0.5)
+            loose = [t.id for t in r.overlap_turnouts if not p.sim.turnout_state(t.id)[1]]
+            self.rt.check(not result.ok and p.sim.section_state(s) == "locked" and not loose, "fault-release",
+                          f"'fault-release {s}' (the overlap) under the open signal {r.signal} with a train "
+                          f"approaching: {result.message}" + (f"; turnouts {', '.join(loose)} unlocked" if loose
+                                                               else ""), p)
+        p.do(f"occupy {r.sections[0]}")  # the train enters and runs towards the overlap
+        p.run(1.0)
+        for a in r.approach:
+            p.do(f"vacate {a}")
+        p.run(1.0)
+        first = r.overlap_sections[0]
+        result = p.do(f"fault-release {first}")
+        delay = self.ctx.rules.section_fault_release_s
+        p.run(delay - 5.0)
+        self.rt.check(result.ok and p.sim.section_state(first) == "locked", "fault-release",
+                      f"'fault-release {first}' (the overlap) with the train running in: {result.message}; the "
+                      f"overlap is {p.sim.section_state(first)} before {delay:g} s", p)
+        p.run(10.0)
+        self.rt.check(p.sim.section_state(first) == "free", "fault-release", f"'fault-release {first}' (the "
+                      f"overlap) with the train running in: still {p.sim.section_state(first)} after {delay:g} s", p)
+
     def fault_release(self) -> None:
-        """Section fault release (区故解) of the locked clear sections ahead of a train that entered the route:
-        granted at once, refused on a station track and on the occupied section."""
+        """Section fault release (区故解) of the locked clear sections ahead of a train that entered the route: refused
+        on a station track and on the occupied section; delayed by the rule set's time while the movement is still on
+        its way to them (it stands in the route), and at once once it has left the route."""
         r = self.r
         if len(r.sections) < 2:
             self.na("fault-release (one section)")
@@ -214,16 +276,62 @@ class ReleaseChecks:
         result = p.do(f"fault-release {r.sections[0]}")
         self.rt.check(not result.ok, "fault-release", f"'fault-release {r.sections[0]}' of the occupied section "
                       f"was accepted: {result.message}", p)
+        ahead = [s for s in r.sections[1:] if not self.st.is_station_track(s)]
         for s in r.sections[1:]:
             result = p.do(f"fault-release {s}")
             if self.st.is_station_track(s):
                 self.rt.check(not result.ok and p.sim.section_state(s) == "locked", "fault-release",
                               f"'fault-release {s}' on a station track: {result.message}", p)
             else:
-                self.rt.check(result.ok and p.sim.section_state(s) == "free", "fault-release",
-                              f"'fault-release {s}': {result.message}; the section is {p.sim.section_state(s)}", p)
+                self.rt.check(result.ok and p.sim.section_state(s) == "locked", "fault-release",
+                              f"'fault-release {s}' ahead of the train standing in {r.sections[0]}: "
+                              f"{result.message}; the section is {p.sim.section_state(s)}, not locked on for the "
+                              "delay", p)
+        delay = self.ctx.rules.section_fault_release_s if r.kind == "train" else self.ctx.rules.release_s["shunt"]
+        p.run(delay - 5.0)
+        early = [s for s in ahead if p.sim.section_state(s) != "locked"]
+        self.rt.check(not early, "fault-release", f"section fault release ahead of the train released "
+                      f"{', '.join(early)} before {delay:g} s", p)
+        p.run(10.0)
+        late = [s for s in ahead if p.sim.section_state(s) != "free"]
+        self.rt.check(not late, "fault-release", f"section fault release ahead of the train: {', '.join(late)} "
+                      f"still not free {delay + 5:g} s after it was given", p)
+        q = Probe(self.ctx)  # the movement has left the route: released at once
+        if not self.rt.opened(q, "opens"):
+            return
+        for step in (*(f"occupy {a}" for a in r.approach), f"occupy {r.sections[0]}",
+                     *(f"vacate {a}" for a in r.approach), f"vacate {r.sections[0]}"):
+            q.do(step)
+            q.run(1.0)
+        for s in ahead:
+            result = q.do(f"fault-release {s}")
+            self.rt.check(result.ok and q.sim.section_state(s) == "free", "fault-release",
+                          f"'fault-release {s}' with the movement gone from the route: {result.message}; the section "
+                          f"is {q.sim.section_state(s)}", q)
 
     # ---- guide, doors --------------------------------------------------------------------------------------------
+    def guide_route(self) -> None:
+        """A guide route (引导进路锁闭) over a red band on the receiving track: selected and locked without looking at
+        its track circuits, the guide aspect shown once its turnouts are in position, every turnout locked."""
+        r, sig = self.r, self.st.signals[self.r.signal]
+        guide = self.ctx.rules.aspects.guide
+        if r.kind != "train" or r.category != "receiving" or r.overlap_alternative or not \
+                self.ctx.rules.aspects.can_show(guide, [lamp.value for lamp in sig.lamps]):
+            self.na("guide route")
+            return
+        p = Probe(self.ctx)
+        faulty = r.sections[-1]
+        p.do(f"occupy {faulty}")
+        refused = p.do(route_line(r))
+        result = p.do(" ".join(["guide", *r.buttons]))
+        p.until(lambda: p.aspect(r.signal) == guide, 40.0)
+        loose = [t.id for t in r.all_turnouts if not p.sim.turnout_state(t.id)[1]]
+        self.rt.check(not refused.ok and result.ok and p.aspect(r.signal) == guide and not loose, "guide",
+                      f"'{' '.join(['guide', *r.buttons])}' with {faulty} showing occupied: {result.message}; the "
+                      f"signal shows {p.aspect(r.signal)}" + (f"; turnouts not locked: {', '.join(loose)}" if loose
+                                                              else "") + ("" if not refused.ok else
+                                                                          f"; '{route_line(r)}' was accepted"), p)
+
     def guide(self) -> None:
         """Guide aspect HB (引导) over a track-circuit fault on the route: shown with the route locked, closed once
         the guided train has passed."""
@@ -348,6 +456,9 @@ class ReleaseChecks:
             if self.rt.opened(p, "opens"):
                 self.vary_blocks(p, r.exit_link, r)
         for o in onward:
+            q = Probe(self.ctx)  # a through train: the departure is usually set first, so the home signal shows L
+            self.rt.check(open_route(q, o, r), "onward", f"'{route_line(o)}', then '{route_line(r)}' (the onward "
+                          f"route first): {q.blocker(r)}; {q.blocker(o)}", q)
             p = Probe(self.ctx)
             if not open_route(p, r, o):
                 self.rt.check(False, "onward", f"'{route_line(r)}' with onward route {o.id}: {p.blocker(r)}; "
@@ -458,20 +569,13 @@ def throat_checks(ctx: Context) -> None:
 
 
 def _bordering_platforms(ctx: Context, signal: str) -> list[str]:
-    """Platforms with screen doors whose track borders the throat ``signal`` leads into (the throat: the tracks
-    reached from the signal without entering a station track or the line), found on the track layout."""
-    st = ctx.station
-    inner = {"throat", "spur"}
-    start = st.signal_entry_track(signal)
-    seen, todo, touched = {start}, [start], set()
-    while todo:
-        for port in st.track_ports[todo.pop()]:
-            for _, nxt in st.node_tracks[port.node]:
-                if nxt in seen:
-                    continue
-                seen.add(nxt)
-                sec = st.tracks[nxt].section
-                touched.add(sec)
-                if st.sections[sec].role.value in inner:
-                    todo.append(nxt)
-    return [pl.id for pl in st.model.platforms if pl.screen_doors and pl.section in touched]
+    """Platforms with screen doors whose track borders the throat ``signal`` leads into, or lies in it
+    (:func:`.lines.reach`)."""
+    inner, border = reach(ctx, signal)
+    return [pl.id for pl in ctx.station.model.platforms if pl.screen_doors and pl.section in inner | border]
+
+
+def _seconds(line: str) -> float:
+    """The time of a probe's 'run' line ('run 2s', 'run 250ms')."""
+    value = line.split()[1]
+    return float(value[:-2]) / 1000.0 if value.endswith("ms") else float(value[:-1])

@@ -18,6 +18,7 @@ from liansuo.stations.station import Station
 
 from ..progress import Advance
 from ..spread import deal, fan_out
+from .lines import guide_area, line_direction
 from .pairs import PairTest
 from .plan import Unit, UnitResult
 from .probe import Context, FirstFailure
@@ -76,6 +77,10 @@ def run_unit(bench: Bench, unit: Unit, *, stop_at_first: bool = False) -> UnitRe
         power_up(ctx)
     elif unit.item == "red-lamp-transfer":
         red_lamp_transfer(ctx)
+    elif unit.item == "line-direction":
+        line_direction(ctx)
+    elif unit.item == "guide-area":
+        guide_area(ctx)
     else:
         raise ValueError(f"unknown unit {unit}")
     return UnitResult(ctx.checks, ctx.failures, ctx.warnings, route)
