@@ -23,12 +23,14 @@ import liansuo.interlocking.derive as derive
 import liansuo.interlocking.lifecycle as lifecycle
 import liansuo.interlocking.locks as locks
 import liansuo.interlocking.operations as operations
+import liansuo.interlocking.overlap as overlap
 import liansuo.interlocking.state as state
 import liansuo.interlocking.stationblock as stationblock
 from liansuo import native_modules
 from liansuo.interlocking.io import RelayBoard, Result
 from liansuo.interlocking.route import Route
 from liansuo.interlocking.state import RouteStage, RouteState
+from liansuo.stations.profile import falling
 
 Apply = Callable[[ExitStack], None]
 
@@ -64,7 +66,8 @@ def _wrap(stack: ExitStack, owner: object, attr: str, make: Callable[[Any], Any]
 # ---- the table ------------------------------------------------------------------------------------------------------
 def _no_head_on(s: ExitStack) -> None:
     _wrap(s, derive, "derive_conflicts",
-          lambda real: lambda routes, rules: real(routes, rules.model_copy(update={"enemy_onto_track": []})))
+          lambda real: lambda routes, rules, is_track: real(routes, rules.model_copy(update={"enemy_onto_track": []}),
+                                                            is_track))
 
 
 def _no_diamonds(s: ExitStack) -> None:
@@ -270,8 +273,8 @@ def _against_running_allowed(s: ExitStack) -> None:
 
 def _guide_stays_open(s: ExitStack) -> None:
     def guide(real: Any) -> Any:
-        def late(self: Any, signal: str) -> Result:
-            result = real(self, signal)
+        def late(self: Any, signal: str, *args: Any) -> Result:
+            result = real(self, signal, *args)
             rs = self.il.route_of(signal)
             if rs is not None:
                 rs.guide_first_clear = False  # closes only once the train is past, not when it enters
@@ -302,17 +305,17 @@ def _table_conflicts_skipped(s: ExitStack) -> None:
     _patch(s, operations.Operator, "_conditional", lambda self, r, rs: "")
 
     def blocker(real: Any) -> Any:
-        def careless(self: Any, r: Route, run_on: Any = None) -> str:
+        def careless(self: Any, r: Route, run_on: Any = None, **kw: Any) -> str:
             with mock.patch.object(r, "conflicts", {}):
-                return real(self, r, run_on)  # type: ignore[no-any-return]
+                return real(self, r, run_on, **kw)  # type: ignore[no-any-return]
         return careless
     _wrap(s, operations.Operator, "route_blocker", blocker)
 
 
 def _route_ignores_locked_sections(s: ExitStack) -> None:
     def blocker(real: Any) -> Any:
-        def careless(self: Any, r: Route, run_on: Any = None) -> str:
-            why = real(self, r, run_on)
+        def careless(self: Any, r: Route, run_on: Any = None, **kw: Any) -> str:
+            why = real(self, r, run_on, **kw)
             return "" if why.startswith("section") and "is locked" in why else why
         return careless
     _wrap(s, operations.Operator, "route_blocker", blocker)
@@ -338,6 +341,75 @@ def _open_skip_blind_to_the_signal_ahead(s: ExitStack) -> None:
 
 def _rest_deaf_to_relays(s: ExitStack) -> None:
     _patch(s, RelayBoard, "pending", lambda self: False)
+
+
+# ---- crossings, overlaps, guide and line direction ------------------------------------------------------------------
+def _no_crossing_check(s: ExitStack) -> None:
+    def flank(real: Any) -> Any:
+        def careless(self: Any, *args: Any) -> Any:
+            protection, fouling = real(self, *args)
+            return protection, [f for f in fouling if f.diamond is None]
+        return careless
+    _wrap(s, derive._Builder, "_flank", flank)
+
+
+def _overlap_fault_release_at_once(s: ExitStack) -> None:
+    def at_once(self: Any, section: str, rid: str) -> Result:
+        self.lifecycle.release_overlap(rid)
+        return Result.accept(f"overlap of {rid} released")
+    _patch(s, operations.Operator, "_fault_release_overlap", at_once)
+
+
+def _fault_release_ahead_at_once(s: ExitStack) -> None:
+    _patch(s, operations.Operator, "_ahead_of_movement", lambda self, rs, i: False)
+
+
+def _direction_change_ignores_guide(s: ExitStack) -> None:
+    def change(real: Any) -> Any:
+        def careless(self: Any, link: str, direction: str) -> Result:
+            with mock.patch.object(self.il, "guide_only", {}):
+                return real(self, link, direction)  # type: ignore[no-any-return]
+        return careless
+    _wrap(s, operations.Operator, "line_direction", change)
+
+
+def _home_ignores_line_direction(s: ExitStack) -> None:
+    _patch(s, core.Core, "line_against", lambda self, signal: "")
+
+
+def _overlap_from_the_yard(s: ExitStack) -> None:
+    """The overlap derived where the throat beyond the end signal falls, not the approach outside the home signal."""
+    def beyond(st: Any, home: str, end_signal: str, rules: Any) -> Any:
+        tracks, turnouts = overlap.throat_beyond(st, end_signal)
+        if not tracks or not st.model.profile:
+            return None
+        sig = st.signals[end_signal]
+        far = st.node_at(st.topology.far_node((tracks[-1], sig.direction)))
+        fall = falling(st.model.profile, st.node_at(sig.at), far, sig.direction)
+        if fall <= rules.overlap_gradient_per_mille:
+            return None
+        sections = tuple(dict.fromkeys(st.tracks[t].section for t in tracks))
+        return overlap.ProfileOverlap(end_signal, sections, tuple(turnouts), fall)
+    _patch(s, derive, "profile_overlap", beyond)
+
+
+def _through_route_in_one_order(s: ExitStack) -> None:
+    """The onward route may run over the overlap only of a receiving route that is set (not one set after it, nor
+    one whose overlap is timing behind its train)."""
+    _wrap(s, operations.Operator, "_continues", lambda real: lambda self, rid, r, section: (
+        rid in self.il.routes and real(self, rid, r, section)))
+
+
+def _guide_route_checks_occupancy(s: ExitStack) -> None:
+    def blocker(real: Any) -> Any:
+        def careless(self: Any, r: Route, run_on: Any = None, **kw: Any) -> str:
+            return real(self, r, run_on)  # type: ignore[no-any-return]
+        return careless
+    _wrap(s, operations.Operator, "route_blocker", blocker)
+
+
+def _guide_blind(s: ExitStack) -> None:
+    _patch(s, core.Core, "guide_only_meets", lambda self, signal, sections, leads_into: False)
 
 
 MUTANTS: tuple[Mutant, ...] = (
@@ -403,4 +475,22 @@ MUTANTS: tuple[Mutant, ...] = (
            "a timer wakes it", _rest_deaf_to_relays),
     Mutant("route-over-locked-sections", "route setting ignores sections other routes hold (an overlap after its "
            "route has released)", _route_ignores_locked_sections, first="danxian"),
+    Mutant("no-crossing-check", "a route over a diamond crossing does not check the section of the track that "
+           "crosses it", _no_crossing_check, first="jiaocha"),
+    Mutant("overlap-fault-release-at-once", "a section fault release of an overlap is carried out at once, under "
+           "the open signal or with a train approaching", _overlap_fault_release_at_once, first="danxian"),
+    Mutant("fault-release-ahead-at-once", "a section fault release ahead of a movement in its route is carried out "
+           "at once", _fault_release_ahead_at_once),
+    Mutant("direction-change-ignores-guide", "the line's direction changes while a guide aspect calls a train in "
+           "from it", _direction_change_ignores_guide, first="podao"),
+    Mutant("home-ignores-line-direction", "a home signal receives from a line set for departures from the station",
+           _home_ignores_line_direction, first="podao"),
+    Mutant("overlap-from-the-yard", "the overlap is derived from the gradient beyond the end signal, not from the "
+           "approach outside the home signal", _overlap_from_the_yard, first="podao"),
+    Mutant("through-route-in-one-order", "a through movement is refused when its departure is set first or its "
+           "overlap is timing", _through_route_in_one_order, first="danxian"),
+    Mutant("guide-route-checks-occupancy", "a guide route is refused over the occupied section it is meant for",
+           _guide_route_checks_occupancy),
+    Mutant("guide-blind", "routes and guide aspects ignore a guide aspect lit under guide total lock",
+           _guide_blind),
 )
