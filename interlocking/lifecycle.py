@@ -256,6 +256,10 @@ class RouteLifecycle:
         if not il.board.lamp_ok(r.signal, stop_aspect(il.station, r.signal)):
             self.close_signal(rs, "red lamp dark: the guide aspect needs the red lamp lit", abnormal=True)
             return
+        guide = il.rules.aspects.guide
+        if il.proven(r.signal, guide) != guide:
+            self.close_signal(rs, f"a lamp of the guide aspect {guide} is dark", abnormal=True)
+            return
         doors = il.doors_blocker(il.door_sections(r))
         if doors:
             self.close_signal(rs, doors, abnormal=True)
@@ -301,7 +305,8 @@ class RouteLifecycle:
             elif il.now >= due:
                 del rs.fault_release_at[i]
                 il.event("release", f"section {secs[i]} released by section fault release ({rs.id})")
-                self.release_section(rs, i)
+                if self.release_by_fault(rs, i):
+                    return
         last = n - 1
         # a shunting movement that drew back out of its route (中途返回): nothing in the route occupied, the section
         # in rear of the signal occupied again; the sections it passed release without the next one occupied
@@ -336,6 +341,22 @@ class RouteLifecycle:
             beyond = self.beyond(rs)
             watched = frozenset((*secs, *r.approach, beyond) if beyond is not None else (*secs, *r.approach))
             rs.release_memo = ReleaseMemo(rs, il.cycles, watched)
+
+    def release_by_fault(self, rs: RouteState, i: int) -> bool:
+        """Section ``i`` released by section fault release (区故解); True when that released the whole route. Where
+        only the receiving track is left after a movement entered and left the route (a flickering relay, a train
+        that backed out), and it shows clear, it goes with the route: it would never release behind a train, and a
+        station track takes no section fault release of its own."""
+        self.release_section(rs, i)
+        left = [k for k, done in enumerate(rs.released) if not done]
+        last = len(rs.sections) - 1
+        if left == [last] and rs.entered and self.il.station.is_station_track(rs.sections[last]) \
+                and self.il.clear(rs.sections[last]):
+            self.release_section(rs, last)
+        if all(rs.released):
+            self.finish(rs, all_sections=False)
+            return True
+        return False
 
     def beyond(self, rs: RouteState) -> str | None:
         """The section just past the route (past its run-on, where it has one)."""
@@ -448,14 +469,13 @@ class RouteLifecycle:
         self.il.event("release", f"overlap of {rid} released")
 
     def _overlaps(self) -> None:
+        """Overlaps held on after their route released, until their time. A section fault release of the overlap
+        given while the train ran in waits here too, for the route to release first (``finish``): the overlap is
+        there for that very train."""
         now = self.il.now
         for rid, at in list(self.il.overlap_pending.items()):
-            rs = self.il.routes.get(rid)  # a route still in use: not before its own overlap time either
-            later = rs.overlap_release_at if rs is not None else None
-            if at is not None and now >= at and (later is None or now >= later):
+            if at is not None and now >= at and rid not in self.il.routes:
                 self.release_overlap(rid)
-                if rs is not None:
-                    rs.overlap_released = True
 
     # ---- the guide aspect without a route (a throat under guide total lock) ---------------------------------
     def open_guide_only(self, signal: str) -> None:
@@ -485,6 +505,8 @@ class RouteLifecycle:
                 il.event("signal", f"guide aspect of {sig} closed")
             elif not il.board.lamp_ok(sig, stop_aspect(il.station, sig)):
                 self.close_guide_only(sig, "red lamp dark, the guide aspect needs it lit")
+            elif il.proven(sig, il.rules.aspects.guide) != il.rules.aspects.guide:
+                self.close_guide_only(sig, f"a lamp of the guide aspect {il.rules.aspects.guide} is dark")
             elif doors := il.doors_blocker(il.guide_only_doors(sig)):
                 self.close_guide_only(sig, doors)
 
@@ -513,8 +535,27 @@ class RouteLifecycle:
                     self.enter_at_danger(il.routes[own])
 
     def approach_locked(self, rs: RouteState) -> bool:
-        """接近锁闭: the signal has been given and a train is in the approach section."""
-        return rs.stage in SIGNAL_GIVEN and any(not self.il.clear(s) for s in rs.route.approach)
+        """接近锁闭: the signal has been given and a train is in the approach section, or, for the onward route of a
+        through movement, a train is coming over the route that ends at its signal (in that route's approach or in
+        it: the signal in rear showed it the way on)."""
+        return rs.stage in SIGNAL_GIVEN and bool(self.approaching(rs.route))
+
+    def approaching(self, r: Route, depth: int = 3) -> list[str]:
+        """The occupied sections from which a train comes to the signal of ``r``: its approach, or a route in rear
+        (given, or in use) that ends at that signal, with the approach of that route (so on, ``depth`` routes back)."""
+        il = self.il
+        out = [s for s in r.approach if not il.clear(s)]
+        if out or depth == 0:
+            return out
+        for other in il.routes.values():
+            o = other.route
+            if o.end_signal == r.signal and o.direction is r.direction and (
+                    other.stage in SIGNAL_GIVEN or other.stage is RouteStage.in_use):
+                out = [s for i, s in enumerate(other.sections) if not other.released[i] and not il.clear(s)]
+                out = out or self.approaching(o, depth - 1)
+                if out:
+                    return out
+        return []
 
 
 def _look(rs: RouteState) -> tuple[object, ...]:

@@ -184,7 +184,8 @@ class Operator:
         into) that track."""
         held = {s for i, s in enumerate(rs.sections) if not rs.released[i]}
         wanted = set(r.all_sections) | (set(run_on.sections) if run_on else set())
-        shared = sorted(wanted & (held | {f.section for f in rs.route.fouling} | set(rs.route.overlap_sections)))
+        overlap = set() if rs.overlap_released else set(rs.route.overlap_sections)
+        shared = sorted(wanted & (held | {f.section for f in rs.route.fouling} | overlap))
         if shared:
             return f"section {shared[0]}"
         if rs.id in r.added_enemies and held:
@@ -223,9 +224,12 @@ class Operator:
         if rs is None:
             return Result.refuse(why)
         if self.lifecycle.approach_locked(rs):
-            occupied = [s for s in rs.route.approach if not self.il.clear(s)]
-            return Result.refuse(f"approach section {', '.join(occupied)} is occupied: route {rs.id} is "
-                                 f"approach-locked (接近锁闭); use 'release {signal}' (manual time release)")
+            occupied = self.lifecycle.approaching(rs.route)
+            own = set(occupied) <= set(rs.route.approach)
+            where = (f"approach section {', '.join(occupied)} is occupied" if own else
+                     f"a train is coming to {signal} through the route in rear (in {', '.join(occupied)})")
+            return Result.refuse(f"{where}: route {rs.id} is approach-locked (接近锁闭); use 'release {signal}' "
+                                 "(manual time release)")
         self.lifecycle.close_if_open(rs, "route cancelled")
         self.lifecycle.finish(rs, all_sections=True)
         self.il.event("route", f"route {rs.id} cancelled")
@@ -279,6 +283,10 @@ class Operator:
         routes = [lk.holder for lk in locks if lk.hold is Hold.route and lk.holder in self.il.routes]
         overlaps = [lk.holder for lk in locks if lk.hold is Hold.overlap]
         if not routes and not overlaps:
+            fouled = [lk.holder for lk in locks if lk.hold is Hold.fouling]
+            if fouled:
+                return Result.refuse(f"section {section} is held only as a fouling section of route {fouled[0]}: it is "
+                                     "released with that route")
             return Result.refuse(f"section {section} is not locked")
         if not self.il.clear(section):
             return Result.refuse(f"section {section} is occupied: only a clear section can be released")
@@ -300,10 +308,10 @@ class Operator:
                           f"{delay:g} s")
             return Result.accept(f"section {section} ({rs.id}) releases in {delay:g} s unless the movement "
                                  "reaches it: it is still on its way")
-        self.lifecycle.release_section(rs, i)
         self.il.event("release", f"section {section} released by section fault release")
-        if all(rs.released):
-            self.lifecycle.finish(rs, all_sections=False)
+        if self.lifecycle.release_by_fault(rs, i):
+            return Result.accept(f"section {section} released; route {rs.id} released with its track "
+                                 f"{rs.sections[-1]}")
         return Result.accept(f"section {section} released")
 
     def _ahead_of_movement(self, rs: RouteState, i: int) -> bool:
@@ -350,8 +358,8 @@ class Operator:
             self.il.overlap_pending[rid] = self.il.now + delay
             self.il.event("route", f"section fault release of {section} (overlap of {rid}) with a train in the "
                           f"route: {delay:g} s")
-            return Result.accept(f"section {section} (overlap of {rid}) releases in {delay:g} s, or later if the "
-                                 "train reaches the end of the route first")
+            return Result.accept(f"section {section} (overlap of {rid}) releases once the route has released, and "
+                                 f"not before {delay:g} s: the overlap is there for the train running in")
         if self.lifecycle.approach_locked(rs):
             return self._fault_release_delayed(rs, section)
         self.lifecycle.release_overlap(rid)
@@ -433,6 +441,8 @@ class Operator:
         doors = self.il.doors_blocker(self.il.guide_only_doors(signal))
         if doors:  # the way is not known: every platform track the signal leads to must have its doors safe
             return Result.refuse(f"guide refused: {doors}")
+        if self.il.proven(signal, guide) != guide:
+            return Result.refuse(f"guide refused: a lamp of the guide aspect {guide} of {signal} is dark")
         self.lifecycle.open_guide_only(signal)
         return Result.accept(f"guide aspect {guide} on {signal} (guide total lock)")
 
@@ -462,6 +472,8 @@ class Operator:
             names = ", ".join(sorted(self.il.table.throats))
             return Result.refuse(f"there is no throat '{throat}'; throats are named by their home signal: {names}")
         turnouts = self.il.table.throats[throat]
+        if not lock and not any(self._guide_locked(t, throat) for t in turnouts):
+            return Result.refuse(f"throat {throat} is not under guide total lock (引导总锁闭)")
         if not lock and throat in self.il.guide_only:
             return Result.refuse(f"the guide aspect of {throat} is open: cancel it before unlocking the throat")
         for t in turnouts:
@@ -539,7 +551,7 @@ class Operator:
         if occupied:
             return Result.refuse(f"power-up release refused: section {', '.join(occupied[:6])}"
                                  f"{' ...' if len(occupied) > 6 else ''} shows occupied; every section of the station "
-                                 "must be clear (confirm on site, then use fault-release after the power-up release)")
+                                 "must show clear first (clear it, or have the track circuit repaired)")
         self.il.locks.release_all(Hold.power_up)
         self.il.power_up_locked = False
         self.il.event("power", "power-up release (上电解锁): every section released")

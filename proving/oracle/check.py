@@ -66,6 +66,7 @@ class _Held(Extent):
 
     unsettled: bool = False  # a turnout of it is not where it should be (the world's doing, being answered)
     operator: bool = False  # a guide aspect over turnouts without indication: the operator answers for the route
+    guided: bool = False  # a guide aspect: its track circuits are not checked, the operator has looked at the way
     in_use: bool = False  # a movement under way (its signal has closed behind it)
 
 
@@ -268,6 +269,7 @@ class Oracle:
         # a guide aspect over turnouts without indication, or under guide total lock (引导总锁闭, where the
         # interlocking checks no route by design): the operator has checked the way by sight and answers for the
         # guided route; what the oracle finds on it is a hazard
+        h.guided = guide
         h.operator = guide and (a.end == "broken" or sig in self.guide_locked
                                 or any(view.proven(t) != p for t, p in a.turnouts.items()))
         if h.operator:
@@ -476,9 +478,10 @@ class Oracle:
             a, b = held[i], held[j]
             if a.auth is b.auth:
                 continue
-            # a guided movement the operator answers for (its track circuits unchecked) meeting a movement already
-            # under way is the operator's; two signals given at once, guided or not, are the interlocking's
-            hazard = (a.operator and b.in_use) or (b.operator and a.in_use)
+            # a guide aspect (its track circuits unchecked by design: the operator has looked at the way) towards a
+            # movement already under way is the operator's; two signals given at once, guided or not, are the
+            # interlocking's
+            hazard = ((a.guided or a.operator) and b.in_use) or ((b.guided or b.operator) and a.in_use)
             delayed = a.unsettled or b.unsettled
             # where the operator released a section of one of them by hand, what follows is on the operator's word
             hazard = hazard or bool(self.fault_released & {*a.sections, *b.sections})
@@ -525,10 +528,13 @@ class Oracle:
                         if partner != t:
                             needs.setdefault(partner, []).append((h, pos, f"{role}, crossover {pair}"))
         for t, target in moving.items():
+            # a turnout in a section the operator released by hand while the movement's authority reached over it
+            # moves on the operator's word, as a route set there does
+            released = self.turnout_section[t] in self.fault_released
             for h, pos, role in needs.get(t, ()):
                 key = f"moved:{t}:{h.name}"
                 found[key] = Finding(key, "moved", f"turnout {t} is moving towards {target} while the authority of "
-                                     f"{h.name} needs it {pos} ({role})", hazard=h.operator)
+                                     f"{h.name} needs it {pos} ({role})", hazard=h.operator or released)
             if self.was_moving.get(t, "") == target:
                 continue
             sec = self.turnout_section[t]
