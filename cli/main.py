@@ -18,6 +18,7 @@ from liansuo.cli import completion, exercise, fuzz, schemas
 from liansuo.interlocking import cli as interlocking
 from liansuo.proving import cli as proving
 from liansuo.proving import mutation, soakcli
+from liansuo.proving.explore import cli as explore
 from liansuo.proving.verify import cli as verify
 from liansuo.remote import cli as remote
 from liansuo.server import cli as server
@@ -41,6 +42,7 @@ REGISTER: tuple[Callable[[Add], None], ...] = (
     proving.register,  # test
     verify.register,  # verify
     soakcli.register,  # soak
+    explore.register,  # explore
     mutation.register,  # mutate
     fuzz.register,  # fuzz
     bench.register,  # bench
