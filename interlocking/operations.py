@@ -295,6 +295,8 @@ class Operator:
         rs = self.il.routes[routes[0]]
         if rs.stage in (RouteStage.open, RouteStage.guide):
             return Result.refuse(f"signal {rs.route.signal} is open over {section}: close it first (cancel)")
+        if self._counting_down(rs):
+            return self._timing(rs, section)
         if self.lifecycle.approach_locked(rs) and not rs.entered:
             return self._fault_release_delayed(rs, section)
         i = rs.sections.index(section)
@@ -334,6 +336,17 @@ class Operator:
         self.il.event("route", f"section fault release of {section} with a train approaching: {delay:g} s")
         return Result.accept(f"section {section} ({rs.id}) releases in {delay:g} s unless a train enters")
 
+    @staticmethod
+    def _counting_down(rs: RouteState) -> bool:
+        return rs.stage is RouteStage.time_release and not rs.entered
+
+    def _timing(self, rs: RouteState, section: str) -> Result:
+        """A route already counting down a time release (manual, or a fault release given with a train approaching)
+        keeps it to the end: the approach showing clear since may be a train that does not shunt (分路不良)."""
+        left = (rs.release_at or self.il.now) - self.il.now
+        return Result.refuse(f"route {rs.id} over {section} is being released by time ({left:.0f} s left): it "
+                             "releases by itself; a section fault release cannot shorten it")
+
     def _fault_release_overlap(self, section: str, rid: str) -> Result:
         """区故解 of a section locked only as the overlap (延续进路) of route ``rid``: as for a section of the route
         itself, refused under the open signal and delayed with a train approaching or running in the route; an
@@ -349,6 +362,8 @@ class Operator:
         if rs.stage in (RouteStage.open, RouteStage.guide):
             return Result.refuse(f"signal {signal} is open over {section} (the overlap of {rid}): close it first "
                                  "(cancel)")
+        if self._counting_down(rs):
+            return self._timing(rs, section)
         if rs.entered:
             if rs.overlap_release_at is not None:
                 return Result.refuse(f"section {section} is the overlap (延续进路) of {rid}: it releases by itself "

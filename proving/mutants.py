@@ -364,6 +364,10 @@ def _fault_release_ahead_at_once(s: ExitStack) -> None:
     _patch(s, operations.Operator, "_ahead_of_movement", lambda self, rs, i: False)
 
 
+def _fault_release_cuts_time_release(s: ExitStack) -> None:
+    _patch(s, operations.Operator, "_counting_down", staticmethod(lambda rs: False))
+
+
 def _direction_change_ignores_guide(s: ExitStack) -> None:
     def change(real: Any) -> Any:
         def careless(self: Any, link: str, direction: str) -> Result:
@@ -481,6 +485,8 @@ MUTANTS: tuple[Mutant, ...] = (
            "the open signal or with a train approaching", _overlap_fault_release_at_once, first="danxian"),
     Mutant("fault-release-ahead-at-once", "a section fault release ahead of a movement in its route is carried out "
            "at once", _fault_release_ahead_at_once),
+    Mutant("fault-release-cuts-time-release", "a section fault release given while its route counts down a time "
+           "release frees the route at once when the approach shows clear", _fault_release_cuts_time_release),
     Mutant("direction-change-ignores-guide", "the line's direction changes while a guide aspect calls a train in "
            "from it", _direction_change_ignores_guide, first="podao"),
     Mutant("home-ignores-line-direction", "a home signal receives from a line set for departures from the station",

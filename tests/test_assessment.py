@@ -149,12 +149,23 @@ def test_a_guide_with_cause_is_not_unsafe() -> None:
 
 
 def test_a_section_fault_release_without_cause_is_unsafe() -> None:
-    """The route X-XI is approach-locked, released by hand; 1DG is freed on top although nothing touched it."""
-    a = attempt("jiaopei-total-release", [(5, "release X"), (8, "fault-release 1DG"), (190, "route X X3")])
+    """The route X-XI stands locked under a home signal that went red for a dark lamp (seed 1), no train near: 1DG
+    is freed although nothing touched it."""
+    a = attempt("jiaopei-guide-home-signal", [(5, "fault-release 1DG")], seed=1)
     report = a.report()
     assert [(u["command"], u["rule"]) for u in report["unsafe"]] == [
         ("fault-release 1DG", "section fault release without cause")]
-    assert report["sealed_uses"] == {"release": 1, "fault-release": 1}
+    assert report["sealed_uses"] == {"fault-release": 1}
+
+
+def test_a_section_fault_release_cannot_cut_a_manual_time_release_short() -> None:
+    """The route X-XI is approach-locked and released by hand: a fault release of 1DG meanwhile is refused (it would
+    have freed the route before its 180 s), and the route releases on time."""
+    a = attempt("jiaopei-total-release", [(5, "release X"), (8, "fault-release 1DG"), (190, "route X X3")])
+    report = a.report()
+    assert report["unsafe"] == [] and report["refused"] == 1 and report["all_goals_met"]
+    (refused,) = [c for c in report["commands"] if not c["ok"]]
+    assert refused["command"] == "fault-release 1DG" and "being released by time" in refused["answer"]
 
 
 def test_a_route_over_a_hidden_wagon_is_unsafe() -> None:

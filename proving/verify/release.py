@@ -77,6 +77,17 @@ class ReleaseChecks:
         if not self.rt.check(ok, "time-release", f"'release {r.signal}': {result.message}; signal shows "
                              f"{p.aspect(r.signal)}, route {p.state(r)}", p):
             return
+        # the approach showing clear again (a train backing off, or one that does not shunt) neither ends the time
+        # release nor lets a section fault release cut it short
+        for s in r.approach:
+            p.do(f"vacate {s}")
+        inner = next((s for s in r.sections if not self.st.is_station_track(s)), None)
+        if inner is not None:
+            result = p.do(f"fault-release {inner}")
+            if not self.rt.check(not result.ok and p.state(r) == "time_release", "time-release",
+                                 f"'fault-release {inner}' during the time release, the approach clear again: "
+                                 f"{result.message}; route {p.state(r)}", p):
+                return
         p.run(delay - 2.0)
         held = [s for s in r.sections if p.sim.section_state(s) != "locked"]
         if not self.rt.check(p.state(r) == "time_release" and not held, "time-release",
