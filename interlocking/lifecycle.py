@@ -278,15 +278,21 @@ class RouteLifecycle:
             rs.stage = RouteStage.closed
 
     def _time_release(self, rs: RouteState) -> None:
+        """The route releases after the delay unless the movement enters it (passes the signal into the first
+        section). A section occupied further in (a red band, a vehicle come another way) neither ends the delay nor
+        is released under it: once the delay is over the route waits for its sections to show clear."""
         il = self.il
-        if any(not il.clear(s) for s in rs.sections):
+        if self._first_occupied(rs):
             rs.stage = RouteStage.in_use
             rs.entered = True
             rs.release_at = None
-            il.event("route", f"time release of {rs.id} abandoned: its route is occupied")
-        elif rs.release_at is not None and il.now >= rs.release_at:
+            il.event("route", f"time release of {rs.id} abandoned: a movement entered {rs.route.sections[0]}")
+        elif rs.release_at is not None and il.now >= rs.release_at and self._all_clear(rs):
             il.event("route", f"route {rs.id} released by manual time release")
             self.finish(rs, all_sections=True)
+
+    def _all_clear(self, rs: RouteState) -> bool:
+        return all(self.il.clear(s) for s in rs.sections)
 
     def _sequential_release(self, rs: RouteState) -> None:
         """Normal release with the three-point check: a section releases when the one in rear has released, this

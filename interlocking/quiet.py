@@ -79,8 +79,9 @@ def quiet_after(core: Core, before: Mark, changes: Changes, routes_settled: bool
         return None
     moves = tuple(core.turnouts[t] for t in core.moving)
     due = [at for at in core.overlap_pending.values() if at is not None]
-    due += [rs.release_at for rs in core.routes.values()
-            if rs.stage is RouteStage.time_release and rs.release_at is not None]
+    due += [rs.release_at for rs in core.routes.values()  # (one over, waiting for its route to clear, waits on it)
+            if rs.stage is RouteStage.time_release and rs.release_at is not None
+            and not (core.now >= rs.release_at and any(not core.clear(s) for s in rs.sections))]
     due += [at for rs in core.routes.values() for at in rs.fault_release_at.values()]
     return Quiet(moves, core.rules.turnout_timeout_s, tuple(core.squeeze_watched()), core.rules.squeeze_alarm_s,
                  tuple(due))

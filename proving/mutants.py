@@ -368,6 +368,17 @@ def _fault_release_cuts_time_release(s: ExitStack) -> None:
     _patch(s, operations.Operator, "_counting_down", staticmethod(lambda rs: False))
 
 
+def _time_release_ends_on_any_occupancy(s: ExitStack) -> None:
+    def ends(real: Any) -> Any:
+        def careless(self: Any, rs: Any) -> None:
+            if any(not self.il.clear(x) for x in rs.sections):
+                rs.stage, rs.entered, rs.release_at = state.RouteStage.in_use, True, None
+                return
+            real(self, rs)
+        return careless
+    _wrap(s, lifecycle.RouteLifecycle, "_time_release", ends)
+
+
 def _direction_change_ignores_guide(s: ExitStack) -> None:
     def change(real: Any) -> Any:
         def careless(self: Any, link: str, direction: str) -> Result:
@@ -487,6 +498,8 @@ MUTANTS: tuple[Mutant, ...] = (
            "at once", _fault_release_ahead_at_once),
     Mutant("fault-release-cuts-time-release", "a section fault release given while its route counts down a time "
            "release frees the route at once when the approach shows clear", _fault_release_cuts_time_release),
+    Mutant("time-release-ends-on-any-occupancy", "a manual time release ends as if a movement had entered when any "
+           "section of the route shows occupied", _time_release_ends_on_any_occupancy),
     Mutant("direction-change-ignores-guide", "the line's direction changes while a guide aspect calls a train in "
            "from it", _direction_change_ignores_guide, first="podao"),
     Mutant("home-ignores-line-direction", "a home signal receives from a line set for departures from the station",

@@ -72,6 +72,7 @@ class ReleaseChecks:
                       f"'cancel {r.signal}' with approach {', '.join(r.approach)} occupied was accepted", p)
         result = p.do(f"release {r.signal}")
         delay = p.sim.interlocking.operator.release_delay(r)
+        t0 = p.sim.t
         p.run(1.0)
         ok = result.ok and p.closed(r.signal) and p.state(r) == "time_release"
         if not self.rt.check(ok, "time-release", f"'release {r.signal}': {result.message}; signal shows "
@@ -88,7 +89,18 @@ class ReleaseChecks:
                                  f"'fault-release {inner}' during the time release, the approach clear again: "
                                  f"{result.message}; route {p.state(r)}", p):
                 return
-        p.run(delay - 2.0)
+        # a section further in showing occupied (a red band, a vehicle come another way) is no movement entering
+        # from the signal: the delay runs on
+        further = next((s for s in r.sections[1:] if not self.st.is_station_track(s)), None)
+        if further is not None:
+            p.do(f"occupy {further}")
+            p.run(1.0)
+            state = p.state(r)
+            p.do(f"vacate {further}")
+            if not self.rt.check(state == "time_release", "time-release", f"{further} showing occupied during the "
+                                 f"time release, nothing entering from {r.signal}: the route went {state}", p):
+                return
+        p.run(t0 + delay - 1.0 - p.sim.t)
         held = [s for s in r.sections if p.sim.section_state(s) != "locked"]
         if not self.rt.check(p.state(r) == "time_release" and not held, "time-release",
                              f"{delay - 1:g} s into the {delay:g} s time release the route is {p.state(r)}"
