@@ -41,7 +41,7 @@ SOAK_STEPS = 300
 class Caught:
     mutant: str
     what: str
-    by: str  # 'verify', 'oracle' (a safety property, during verify or a soak), or '' (not caught)
+    by: str  # 'verify', 'oracle' (a safety property) or 'judge' (a command or release), during verify or a soak;
     station: str = ""
     check: str = ""
     detail: str = ""
@@ -80,14 +80,14 @@ def try_mutant(m: Mutant, stations: Sequence[Station], soak_steps: int = SOAK_ST
             rep = verify_station(st, stop_at_first=True)
             if rep.failures:
                 f = rep.failures[0]
-                by = "oracle" if f.check == "oracle" else "verify"
+                by = f.check if f.check in ("oracle", "judge") else "verify"
                 return Caught(m.name, m.what, by, st.id, f.check if by == "verify" else f.subject, f.detail,
                               time.perf_counter() - t0)
         for st in stations:
             run = soak(st, soak_steps, 1)
             if run.violations:
                 v = run.violations[0][0]
-                return Caught(m.name, m.what, "oracle", st.id, v.prop, f"soak: {v.text}", time.perf_counter() - t0)
+                return Caught(m.name, m.what, v.source, st.id, v.prop, f"soak: {v.text}", time.perf_counter() - t0)
     return Caught(m.name, m.what, "", seconds=time.perf_counter() - t0)
 
 

@@ -35,7 +35,8 @@ from ..oracle.watch import Watch
 def state_key(sim: Simulation, watch: Watch) -> bytes:
     """A 16-byte digest of the state of ``sim`` and of the oracle watching it."""
     clock = Clock(sim.t)
-    data = (interlocking_part(sim, clock), field_part(sim, clock), oracle_part(sim, watch, clock))
+    data = (interlocking_part(sim, clock), field_part(sim, clock), oracle_part(sim, watch, clock),
+            judge_part(watch, clock))
     # written with repr, not pickle: a pickle's bytes follow which equal values happen to be one object
     return hashlib.blake2b(repr(clock.ranked(data)).encode(), digest_size=16).digest()
 
@@ -177,3 +178,16 @@ def oracle_part(sim: Simulation, watch: Watch, clock: Clock) -> tuple[object, ..
 
 def _sorted(xs: Iterable[str]) -> tuple[str, ...]:
     return tuple(sorted(xs))
+
+
+def judge_part(watch: Watch, clock: Clock) -> tuple[object, ...]:
+    """The reference judge's memory: the routes it follows and what they owe, its timers as the clock's."""
+    if watch.judge is None:
+        return ()
+    m = watch.judge.memory
+    claims = tuple(sorted((c.signal, c.kind, c.given, c.path, c.end_signal, c.entered, clock.timer(c.hold_until),
+                           c.guide_since is not None, c.guide_approached, c.guide_entered_at, c.guide_first_clear,
+                           c.overlap_owed, c.first_clear, c.guided) for c in m.claims.values()))
+    holds = tuple(sorted((h.what, h.sections, clock.timer(h.until)) for h in m.holds))
+    watched = {s for c in m.claims.values() for s in c.path} | {s for h in m.holds for s in h.sections}
+    return (claims, holds, m.powered_up, _sorted(m.locked & watched), m.commanded, _sorted(m.active))

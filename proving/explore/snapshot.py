@@ -37,6 +37,8 @@ class Shared:
         flank = oracle.flank
         for name in ("role", "fouled", "partners", "limit"):
             named[f"flank.{name}"] = getattr(flank, name)
+        if watch.judge is not None:
+            named["judge.tables"] = watch.judge.tables
         self.by_name = named
         self.by_id = {id(obj): name for name, obj in named.items()}
 
@@ -63,13 +65,15 @@ def take(sim: Simulation, watch: Watch, shared: Shared) -> bytes:
     """The state of ``sim`` and of the oracle watching it."""
     buf = io.BytesIO()
     oracle = watch.oracle
-    _Pickler(buf, shared).dump(([getattr(sim, name) for name in _PARTS], oracle.flank._cache, _oracle_memory(oracle)))
+    judge = watch.judge.memory if watch.judge is not None else None
+    _Pickler(buf, shared).dump(([getattr(sim, name) for name in _PARTS], oracle.flank._cache, _oracle_memory(oracle),
+                                judge))
     return buf.getvalue()
 
 
 def restore(sim: Simulation, watch: Watch, shared: Shared, data: bytes) -> None:
     """Put ``sim`` and its oracle back in the state ``data`` was taken in."""
-    parts, flank_cache, memory = _Unpickler(io.BytesIO(data), shared).load()
+    parts, flank_cache, memory, judge = _Unpickler(io.BytesIO(data), shared).load()
     for name, value in zip(_PARTS, parts, strict=True):
         setattr(sim, name, value)
     sim.view = InterlockingView(sim.interlocking)
@@ -77,6 +81,8 @@ def restore(sim: Simulation, watch: Watch, shared: Shared, data: bytes) -> None:
     oracle = watch.oracle
     oracle.flank._cache = flank_cache
     vars(oracle).update(memory)
+    if watch.judge is not None:
+        watch.judge.memory = judge
     view = watch.view
     view.field = sim.field
     view._wheelsets = None

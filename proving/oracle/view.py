@@ -46,6 +46,10 @@ class FieldView(Protocol):
     def locked(self, turnout: str) -> bool:
         """The interlocking reports the turnout locked (route, overlap, single lock, guide lock, power-up)."""
 
+    def section_locked(self, section: str) -> bool:
+        """The console shows the section locked (a white band: a route, an overlap, the power-up lock): what the
+        reference judge reads of the releases, never the oracle."""
+
     def wheelsets(self, tracks: set[str]) -> list[tuple[str, float]]:
         """Wheelsets (track, position) standing on any of ``tracks``, where the world knows them."""
 

@@ -31,10 +31,11 @@ class Violation:
     cycle: int  # the interlocking's cycle count
     key: str = ""  # what it is about (the same key is the same finding)
     hazard: bool = False  # a danger the interlocking cannot see by design, not a violation of its own
+    source: str = "oracle"  # who found it: the safety oracle, or the reference judge of commands and releases
 
     def as_dict(self) -> dict[str, object]:
         return {"t": self.t, "property": self.prop, "text": self.text, "cycle": self.cycle, "key": self.key,
-                "hazard": self.hazard}
+                "hazard": self.hazard, "source": self.source}
 
 
 class SimulationView:
@@ -117,6 +118,9 @@ class SimulationView:
             self._wheelsets = (self.sim.t, every)
         return [(t, x) for t, x in self._wheelsets[1] if t in tracks]
 
+    def section_locked(self, section: str) -> bool:
+        return self.sim.section_state(section) == "locked" or self.sim.view.section(section).locked
+
     def doors_safe(self, section: str) -> bool:
         doors = self.field.doors
         return all(not doors[k].is_open or doors[k].faults.bypass for k in self.platform_keys.get(section, ()))
@@ -144,9 +148,14 @@ class Watch:
     """An oracle attached to a simulation; ``violations`` and ``hazards`` are what it found, in order."""
 
     def __init__(self, sim: Simulation, *, attach: bool = True, rules: RuleSet | None = None,
-                 reaction: int = 2) -> None:
+                 reaction: int = 2, judge: bool = True) -> None:
+        """``judge``: the reference judge of commands and releases (:mod:`proving.judge`) watches beside the oracle,
+        and its findings are reported as violations too."""
+        from ..judge import Judge  # the judge reads what the oracle's view reads, and the oracle's geometry
+
         self.sim = sim
         self.oracle = Oracle(sim.station, rules or sim.rules, cycle_s=sim.cycle_s, reaction=reaction)
+        self.judge = Judge(sim.station, rules or sim.rules, reaction=reaction) if judge else None
         self.view = SimulationView(sim, rules)
         self.violations: list[Violation] = []
         self.hazards: list[Violation] = []
@@ -175,7 +184,7 @@ class Watch:
         def watched_rest(limit: int) -> int:
             # cycles at rest change nothing the oracle reads (its signature stays), so they are checked by counting,
             # unless a finding waits for the interlocking's answer or an overlap's time runs (``Oracle.busy``)
-            if self.oracle.busy():
+            if self.oracle.busy() or (self.judge is not None and self.judge.busy()):
                 return 0
             n = rest(limit)
             self.cycles += n
@@ -204,6 +213,8 @@ class Watch:
         except ValueError:
             return
         self.oracle.note(words, result.ok)
+        if self.judge is not None:
+            self._record(self.judge.note(words, result.ok, self.view, self.sim.t), "judge")
 
     def _signature(self) -> tuple[object, ...]:
         """What the world looks like, in a few numbers: when it is the same as at the last check and nothing there
@@ -218,12 +229,23 @@ class Watch:
     def check(self) -> list[Finding]:
         self.cycles += 1
         signature = self._signature()
-        if signature == self._last and not self.oracle.busy():
+        judge = self.judge
+        if signature == self._last and not self.oracle.busy() and (judge is None or not judge.busy()):
+            if judge is not None:
+                judge.memory.commanded = False  # nothing changed: the command released nothing
             return []
         self._last = signature
-        new = self.oracle.check(self.view, self.sim.t, self.view.showing())
-        cycle = self.sim.interlocking.core.cycles  # to name the cycle in the report, not to judge
-        for f in new:
-            v = Violation(self.sim.t, f.prop, f.text, cycle, f.key, f.hazard)
-            (self.hazards if f.hazard else self.violations).append(v)
+        showing = self.view.showing()
+        new = self.oracle.check(self.view, self.sim.t, showing)
+        self._record(new)
+        if judge is not None:
+            judged = judge.check(self.view, self.sim.t, showing)
+            self._record(judged, "judge")
+            new += judged
         return new
+
+    def _record(self, found: list[Finding], source: str = "oracle") -> None:
+        cycle = self.sim.interlocking.core.cycles  # to name the cycle in the report, not to judge
+        for f in found:
+            v = Violation(self.sim.t, f.prop, f.text, cycle, f.key, f.hazard, source)
+            (self.hazards if f.hazard else self.violations).append(v)

@@ -14,9 +14,9 @@ does.
 from __future__ import annotations
 
 from liansuo.interlocking.table import Route
-from liansuo.stations.schema import SectionRole, SignalKind
+from liansuo.stations.schema import SectionRole
 
-from ..oracle.authority import Tracer
+from ..judge.rules import approach_extent as rules_extent
 from ..oracle.pairs import PaperOracle, RouteSpec
 from .probe import Context
 
@@ -59,35 +59,13 @@ def _how(a: object) -> str:
 
 
 def approach_extent(ctx: Context) -> None:
-    """Every route's approach (接近区段) reaches as far as the rule set says, traced here from the block signals in
-    rear: a home signal on an automatic line counts block sections (the authority of the block signal whose path
-    ends at the home signal, then of the one in rear of that), every other signal the section in rear."""
-    st = ctx.station
-    tracer = Tracer(st)
-    ends_at: dict[str, str] = {}  # signal -> the block signal whose authority ends at it
-    for s in st.model.signals:
-        if s.kind is SignalKind.block:
-            a = tracer.trace(s.id, "train", lambda t: None)
-            if a.end_signal is not None:
-                ends_at[a.end_signal] = s.id
-    rules = ctx.rules.approach_locking
-    for sig in st.model.signals:
+    """Every route's approach (接近区段) reaches as far as the rule set says, traced on the track layout from the
+    block signals in rear (:func:`proving.judge.rules.approach_extent`, which the reference judge reads too)."""
+    extent = rules_extent(ctx.station, ctx.rules)
+    for sig in ctx.station.model.signals:
         if sig.approach:
             continue  # the station file says
-        rear = st.signal_rear_track(sig.id)
-        if rear is None:
-            continue
-        want = [st.tracks[rear].section]
-        link = next((lk for lk in st.model.links if want[0] in lk.sections), None)
-        if sig.kind is SignalKind.home and link is not None and link.kind.value == "automatic":
-            want = []
-            at = sig.id
-            for _ in range(rules.home.get("automatic", 1)):
-                block = ends_at.get(at)
-                if block is None:
-                    break
-                want += tracer.trace(block, "train", lambda t: None).sections
-                at = block
+        want = extent.get(sig.id, ())
         for r in ctx.table.routes.values():
             if r.signal == sig.id:
                 missing = [s for s in want if s not in r.approach]

@@ -92,7 +92,7 @@ class Probe:
         for v in found[self._reported:]:
             if v.text not in self.ctx.oracle_seen:
                 self.ctx.oracle_seen.add(v.text)
-                self.ctx.fail(Failure("oracle", v.prop, f"at t = {v.t:g} s: {v.text}", self.script(), v.text))
+                self.ctx.fail(Failure(v.source, v.prop, f"at t = {v.t:g} s: {v.text}", self.script(), v.text))
         self._reported = len(found)
 
     # ---- driving ------------------------------------------------------------------------------------------------

@@ -10,6 +10,7 @@ from liansuo.interlocking.aspects import is_open
 from liansuo.interlocking.table import Route
 from liansuo.stations.schema import Link, SignalKind
 
+from ..judge.rules import fault_release_delay, overlap_time, release_delay
 from .lines import reach
 from .probe import Context, Failure, Probe, against_running, open_route, other, prepare, route_line
 from .routecheck import RouteCheck
@@ -71,7 +72,7 @@ class ReleaseChecks:
         self.rt.check(not result.ok and p.state(r) != "released", "approach-locking",
                       f"'cancel {r.signal}' with approach {', '.join(r.approach)} occupied was accepted", p)
         result = p.do(f"release {r.signal}")
-        delay = p.sim.interlocking.operator.release_delay(r)
+        delay = release_delay(self.st, self.ctx.rules, r.signal, r.kind)  # the published rule, not the product's
         t0 = p.sim.t
         p.run(1.0)
         ok = result.ok and p.closed(r.signal) and p.state(r) == "time_release"
@@ -209,16 +210,17 @@ class ReleaseChecks:
             if result.ok:
                 p.do(f"cancel {o.signal}")
         self.through_while_held(p)
-        p.run(r.overlap_release_s - 3.0)
+        time = overlap_time(self.st, self.ctx.rules, r.end_signal or "")  # the published rule, not the table's
+        p.run(time - 3.0)
         held = [s for s in r.overlap_sections if p.sim.section_state(s) != "locked"]
         if not self.rt.check(not held, "overlap", f"overlap released early ({', '.join(held)}), before its "
-                             f"{r.overlap_release_s:g} s", p):
+                             f"{time:g} s", p):
             return
         p.run(4.0)
         held = [s for s in r.overlap_sections if p.sim.section_state(s) == "locked"]
         held += [f"turnout {t.id}" for t in r.overlap_turnouts if p.sim.turnout_state(t.id)[1]]
-        self.rt.check(not held, "overlap", f"{r.overlap_release_s:g} s after the train stopped the overlap still "
-                      f"holds {', '.join(held)}", p)
+        self.rt.check(not held, "overlap", f"{time:g} s after the train stopped the overlap still holds "
+                      f"{', '.join(held)}", p)
 
     def through_while_held(self, p: Probe) -> None:
         """With the train on the receiving track and the overlap held for it, each onward departure that continues
@@ -308,7 +310,7 @@ class ReleaseChecks:
                               f"'fault-release {s}' ahead of the train standing in {r.sections[0]}: "
                               f"{result.message}; the section is {p.sim.section_state(s)}, not locked on for the "
                               "delay", p)
-        delay = self.ctx.rules.section_fault_release_s if r.kind == "train" else self.ctx.rules.release_s["shunt"]
+        delay = fault_release_delay(self.ctx.rules, r.kind)
         p.run(delay - 5.0)
         early = [s for s in ahead if p.sim.section_state(s) != "locked"]
         self.rt.check(not early, "fault-release", f"section fault release ahead of the train released "
