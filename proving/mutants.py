@@ -427,6 +427,107 @@ def _guide_blind(s: ExitStack) -> None:
     _patch(s, core.Core, "guide_only_meets", lambda self, signal, sections, leads_into: False)
 
 
+# ---- timers, commands, queued moves and lamps beyond the first ---------------------------------------------------
+def _release_delay_tenth(s: ExitStack) -> None:
+    _wrap(s, operations.Operator, "release_delay", lambda real: lambda self, r: real(self, r) / 10)
+
+
+def _shunt_delay_for_trains(s: ExitStack) -> None:
+    def delay(self: Any, r: Route) -> float:
+        own = self.il.station.signals[r.signal].release_s
+        return own if own is not None else float(self.il.rules.release_s["shunt"])
+    _patch(s, operations.Operator, "release_delay", delay)
+
+
+def _overlap_time_tenth(s: ExitStack) -> None:
+    def add(real: Any) -> Any:
+        def hasty(self: Any, routes: dict[str, Route], *args: Any) -> None:
+            before = set(routes)
+            real(self, routes, *args)
+            for rid in set(routes) - before:
+                routes[rid].overlap_release_s /= 10
+        return hasty
+    _wrap(s, derive._Builder, "_add", add)
+
+
+def _guide_never_times_out(s: ExitStack) -> None:
+    def forever(real: Any) -> Any:
+        def careless(self: Any, *args: Any) -> None:
+            patient = self.il.rules.model_copy(update={"guide_close_s": float("inf")})
+            with mock.patch.object(self.il, "rules", patient):
+                real(self, *args)
+        return careless
+    _wrap(s, lifecycle.RouteLifecycle, "_keep_guide", forever)
+    _wrap(s, lifecycle.RouteLifecycle, "_guide_only", forever)
+
+
+def _power_up_release_over_occupancy(s: ExitStack) -> None:
+    def release(real: Any) -> Any:
+        def careless(self: Any) -> Result:
+            with mock.patch.object(self.il, "clear", lambda section: True):
+                return real(self)  # type: ignore[no-any-return]
+        return careless
+    _wrap(s, operations.Operator, "power_up_release", release)
+
+
+def _fault_release_of_station_track(s: ExitStack) -> None:
+    def release(real: Any) -> Any:
+        def careless(self: Any, section: str) -> Result:
+            with mock.patch.object(self.il.station, "is_station_track", lambda sec: False):
+                return real(self, section)  # type: ignore[no-any-return]
+        return careless
+    _wrap(s, operations.Operator, "fault_release", release)
+
+
+def _fault_release_under_open_signal(s: ExitStack) -> None:
+    def release(real: Any) -> Any:
+        def careless(self: Any, section: str) -> Result:
+            shown = [rs for rs in self.il.routes.values()
+                     if rs.stage is RouteStage.open and section in (*rs.sections, *rs.route.overlap_sections)]
+            for rs in shown:
+                rs.stage = RouteStage.locked
+            try:
+                return real(self, section)  # type: ignore[no-any-return]
+            finally:
+                for rs in shown:
+                    if rs.stage is RouteStage.locked:
+                        rs.stage = RouteStage.open
+        return careless
+    _wrap(s, operations.Operator, "fault_release", release)
+
+
+def _reopen_without_conditions(s: ExitStack) -> None:
+    def reopen(real: Any) -> Any:
+        def careless(self: Any, signal: str) -> Result:
+            with mock.patch.object(self.il, "open_blocker", lambda rs: ""):
+                return real(self, signal)  # type: ignore[no-any-return]
+        return careless
+    _wrap(s, operations.Operator, "reopen", reopen)
+
+
+def _queued_move_under_a_vehicle(s: ExitStack) -> None:
+    """A move waiting in the queue is started without looking again at its turnout's section."""
+    def supervise(real: Any) -> Any:
+        def careless(self: Any) -> None:
+            waiting = {self.turnouts[t].section for t in self.queue}
+            sound = self.clear
+            with mock.patch.object(self, "clear", lambda sec: sec in waiting or sound(sec)):
+                real(self)
+        return careless
+    _wrap(s, core.Core, "_supervise_turnouts", supervise)
+
+
+def _second_lamp_unproved(s: ExitStack) -> None:
+    """Lamp proving looks at the first lamp of an aspect only (a dark second yellow of UU goes unnoticed)."""
+    def dark(self: Any, signal: str, aspect: str) -> set[str]:
+        lamps = self.rules.lamps.get(aspect, [])[:1]
+        out = {lamp for lamp in lamps if not self.board.lamp_ok(signal, lamp)}
+        if aspect in self.rules.aspects.flashing and not self.board.flasher_ok(signal):
+            out.add("flasher")
+        return out
+    _patch(s, core.Core, "_dark", dark)
+
+
 MUTANTS: tuple[Mutant, ...] = (
     Mutant("no-head-on-enemies", "the table leaves out opposing routes onto one track (train against train or "
            "shunting movement)", _no_head_on),
@@ -512,4 +613,22 @@ MUTANTS: tuple[Mutant, ...] = (
            _guide_route_checks_occupancy),
     Mutant("guide-blind", "routes and guide aspects ignore a guide aspect lit under guide total lock",
            _guide_blind),
+    Mutant("release-delay-a-tenth", "a manual time release waits a tenth of its delay (18 s for 180 s)",
+           _release_delay_tenth),
+    Mutant("shunt-delay-for-trains", "a manual time release of a train route waits the shunting delay (30 s)",
+           _shunt_delay_for_trains),
+    Mutant("overlap-time-a-tenth", "the overlap releases a tenth of its time after the train reached the receiving "
+           "track", _overlap_time_tenth, first="danxian"),
+    Mutant("guide-never-times-out", "an unused guide aspect stays lit for ever", _guide_never_times_out),
+    Mutant("power-up-release-over-occupancy", "the power-up release is given with sections showing occupied",
+           _power_up_release_over_occupancy),
+    Mutant("fault-release-of-station-track", "a section fault release of a station track is carried out",
+           _fault_release_of_station_track),
+    Mutant("fault-release-under-open-signal", "a section fault release is carried out under the open signal",
+           _fault_release_under_open_signal),
+    Mutant("reopen-without-conditions", "a signal closed abnormally is reopened without its conditions checked",
+           _reopen_without_conditions),
+    Mutant("queued-move-under-a-vehicle", "a turnout move waiting in the queue starts without looking again at "
+           "its section", _queued_move_under_a_vehicle),
+    Mutant("second-lamp-unproved", "lamp proving looks at an aspect's first lamp only", _second_lamp_unproved),
 )

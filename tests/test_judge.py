@@ -1,7 +1,8 @@
 """The reference judge of commands and releases (``proving/judge``): what the oracle has no view of (approach
-locking, release timing, the power-up lock, the guide aspect closing, the overlap's time). Each seeded defect below
-passes the oracle alone and is found by the judge with the property that breaks, while the sound interlocking gives
-it nothing to say. Its independence of the interlocking is held by ``tests/test_oracle.py`` (imports)."""
+locking, release timing, the power-up lock, reopening, the guide aspect closing, the overlap's time). Each seeded
+defect below passes the oracle alone and is found by the judge with the property that breaks, while the sound
+interlocking gives it nothing to say. Its independence of the interlocking is held by ``tests/test_oracle.py``
+(imports)."""
 
 from __future__ import annotations
 
@@ -31,6 +32,9 @@ CASES = [
      "occupy 7DG; run 3s", "guide"),
     ("overlap-released-at-once", DANXIAN, "route X XI; run 5s; occupy IAG; run 1s; occupy 1DG; run 1s; vacate IAG; "
      "run 1s; occupy IG; run 1s; vacate 1DG; run 5s", "overlap-time"),
+    ("release-delay-a-tenth", MINIMAL, "route X XI; run 3s; occupy IAG; run 1s; release X; run 20s", "release"),
+    ("reopen-without-conditions", MINIMAL, "route X XI; run 3s; occupy 1DG; run 1s; reopen X; run 1s", "reopen"),
+    ("guide-never-times-out", "jiaopei", "route X XI; run 5s; occupy IG; run 1s; guide X; run 70s", "guide"),
 ]
 
 

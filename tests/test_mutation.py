@@ -27,10 +27,15 @@ def test_at_least_twenty_distinct_defects_and_95_percent_caught() -> None:
     assert by["no-red-lamp-transfer-on-the-line"].by == "oracle"
     assert by["no-three-point-check"].check == "three-point-check"
     assert by["throw-ignores-section-locks"].by
+    # the blind spots of timers, commands, queued moves and lamps beyond the first, each seen by what sees it
+    assert by["release-delay-a-tenth"].by == "judge" and by["overlap-time-a-tenth"].check == "overlap-time"
+    assert by["reopen-without-conditions"].check == "reopen"
+    assert by["queued-move-under-a-vehicle"].by == "oracle" and by["second-lamp-unproved"].by == "oracle"
+    assert by["guide-never-times-out"].check == "guide"
 
 
 def test_the_mutate_command_reports_the_score(capsys: pytest.CaptureFixture[str]) -> None:
-    assert main(["mutate", "--station", "jiaopei", "--mutant", "blind-to-occupancy", "--mutant",
+    assert main(["mutate", "--station", "jiaopei", "--mutant", "blind-to-indication", "--mutant",
                  "cancel-ignores-approach", "--format", "json"]) == 0
     rep = json.loads(capsys.readouterr().out)
     assert rep["mutants"] == 2 and rep["caught"] == 2 and rep["score"] == 1.0

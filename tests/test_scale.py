@@ -153,7 +153,7 @@ def test_the_plan_covers_the_table_with_batches_and_counts_every_pair() -> None:
     assert proved == compatible
     assert len(batches) < len(compatible)  # batches prove several pairs at once
     assert [u.item for u in work.units if u.kind == "station"] == ["throats", "power-up", "red-lamp-transfer",
-                                                                   "line-direction", "guide-area"]
+                                                                   "line-direction", "guide-area", "queued-move"]
 
 
 def _pair_units_by_scanning(table: InterlockingTable, focus: set[str] | None) -> tuple[list[tuple[str, ...]], list[

@@ -13,6 +13,7 @@ accepted, the aspects lit, the sections shown locked, the track relays):
   the receiving track the train stands on);
 - ``power-up``: after the interlocking starts, nothing is set and no turnout thrown before the power-up release
   (上电解锁), and that release is never given with a section of the station showing occupied;
+- ``reopen``: a signal closed abnormally is never reopened (重复开放) while a section of its route shows occupied;
 - ``guide``: a guide aspect (引导, HB) closes once the guided train has entered, and closes by itself after the rule
   set's ``guide_close_s`` unused;
 - ``overlap-time``: an overlap (延续进路) stays locked for its release time after the train reached the receiving
@@ -159,6 +160,11 @@ class Judge:
                 del m.claims[sig]
         elif word == "fault-release":
             out += self._fault_release(words, view, now)
+        elif word == "reopen" and sig in m.claims:
+            busy = [s for s in m.claims[sig].path if not view.clear(s)]
+            if busy:
+                out.append(self._finding("reopen", words, f"'reopen {sig}' was accepted with {busy[0]} of its route "
+                                         "showing occupied (重复开放 needs the conditions back)"))
         return out
 
     def _fault_release(self, words: list[str], view: FieldView, now: float) -> list[Finding]:

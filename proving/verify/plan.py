@@ -61,7 +61,7 @@ class Plan:
     apart: list[int] = field(default_factory=list)  # of those, the partners it is apart from
 
 
-STATION_ITEMS = ("throats", "power-up", "red-lamp-transfer", "line-direction", "guide-area")
+STATION_ITEMS = ("throats", "power-up", "red-lamp-transfer", "line-direction", "guide-area", "queued-move")
 
 
 def plan(table: InterlockingTable, focus: set[str] | None, *, pairs: bool, near: list[int] | None = None) -> Plan:

@@ -387,6 +387,7 @@ class ReleaseChecks:
                              f"'guide {r.signal}' with {faulty} showing occupied: {result.message}; the signal "
                              f"shows {p.aspect(r.signal)}", p):
             return
+        self.guide_unused(faulty)
         loose = [t.id for t in r.all_turnouts if not p.sim.turnout_state(t.id)[1]]
         self.rt.check(not loose, "guide", f"turnouts not locked under the guide aspect: {', '.join(loose)}", p)
         doors = self.door_platforms()
@@ -411,6 +412,21 @@ class ReleaseChecks:
         self.rt.check(p.closed(r.signal), "guide", f"the guided train entered {r.sections[0]} (its tail still in the "
                       f"approach): {r.signal} still shows {p.aspect(r.signal)}", p)
 
+    def guide_unused(self, faulty: str) -> None:
+        """A guide aspect no train comes to closes by itself after the rule set's ``guide_close_s`` (the time from
+        the rule data, not from the interlocking)."""
+        r, guide = self.r, self.ctx.rules.aspects.guide
+        q = Probe(self.ctx)
+        if not self.rt.opened(q, "opens"):
+            return
+        q.do(f"occupy {faulty}")
+        q.run(1.0)
+        q.do(f"guide {r.signal}")
+        limit = self.ctx.rules.guide_close_s
+        q.run(limit + 2.0)
+        self.rt.check(q.aspect(r.signal) != guide, "guide", f"the guide aspect of {r.signal} still lit "
+                      f"{limit + 2.0:g} s after it was given, with no train coming (it closes after {limit:g} s)", q)
+
     def lamps(self) -> None:
         """A lamp of the aspect shown goes dark (both filaments): the interlocking commands a more restrictive
         aspect (the rule set's downgrade), never keeps the one it can no longer show."""
@@ -421,15 +437,19 @@ class ReleaseChecks:
         shown = p.aspect(r.signal)
         lamps = [lamp for lamp in self.ctx.rules.lamps.get(shown, [])
                  if lamp in {x.value for x in self.st.signals[r.signal].lamps}]
-        if not lamps:
-            return
-        lamp = lamps[0]
-        p.do(f"fault filament {r.signal} lamp={lamp} which=both")
-        p.run(1.0)
-        after = p.aspect(r.signal)
         rank = self.ctx.rules.aspects.rank_of
-        self.rt.check(after != shown and rank(after) <= rank(shown), "lamp-proving",
-                      f"lamp {lamp} of {r.signal} dark while it showed {shown}: the interlocking commands {after}", p)
+        for i, lamp in enumerate(lamps):  # each lamp of the aspect, the second yellow of UU as much as the first
+            if i:
+                p = Probe(self.ctx)
+                if not self.rt.opened(p, "opens"):
+                    return
+            p.do(f"fault filament {r.signal} lamp={lamp} which=both")
+            p.run(1.0)
+            after = p.aspect(r.signal)
+            if not self.rt.check(after != shown and rank(after) <= rank(shown), "lamp-proving",
+                                 f"lamp {lamp} of {r.signal} dark while it showed {shown}: the interlocking commands "
+                                 f"{after}", p):
+                return
 
     def door_platforms(self) -> list[str]:
         rear = self.st.signal_rear_track(self.r.signal)

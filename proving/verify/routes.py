@@ -287,6 +287,11 @@ class RouteTest(RouteCheck):
         if not self.check(p.closed(sig), check, f"{what}: signal {sig} still shows {p.aspect(sig)}", p):
             return False
         self.closing_alarm(p)
+        result = p.do(f"reopen {sig}")  # the cause still there: never reopened
+        p.run(1.0)
+        if not self.check(not result.ok and p.closed(sig), "reopen", f"'reopen {sig}' before {repaired}: "
+                          f"{'accepted' if result.ok else result.message}; signal shows {p.aspect(sig)}", p):
+            return False
         p.do(repair)
         p.run(5.0)
         if not self.check(p.closed(sig), "no-automatic-reopening", f"signal {sig} reopened by itself "

@@ -50,6 +50,34 @@ def power_up(ctx: Context) -> None:
                f"{result.message}" + (f"; still locked: {', '.join(still)}" if still else ""), p)
 
 
+def queued_move(ctx: Context) -> None:
+    """A turnout move waiting in the queue (more moves asked than the rule set's ``turnout_concurrency`` drive at
+    once) is never started after a vehicle has entered its turnout's section: the interlocking looks at the section
+    again when the move's turn comes. Each throw counts as one move (a crossover pair or a driven turnout queues
+    more), so the last one thrown surely waits."""
+    st = ctx.station
+    p = Probe(ctx)
+    asked: list[tuple[str, str]] = []  # (turnout, its position before the throw)
+    for t in sorted(st.turnouts):
+        if any(t in members and t != members[0] for members in st.pairs.values()):
+            continue  # thrown with its partner
+        was = p.sim.turnout_state(t)[0]
+        if was is None or not p.do(f"throw {t} {'reverse' if was == 'normal' else 'normal'}").ok:
+            continue
+        asked.append((t, was))
+        if len(asked) > ctx.rules.turnout_concurrency:
+            break
+    if len(asked) <= ctx.rules.turnout_concurrency:
+        return  # too few turnouts to fill the drives: no move ever waits
+    t, was = asked[-1]
+    section = st.turnout_section[t]
+    p.do(f"occupy {section}")
+    p.run(ctx.rules.turnout_timeout_s + 2.0)  # every move before it has ended (or timed out) by then
+    now = p.sim.turnout_state(t)[0]
+    ctx.record(now == was, "queued-move", "turnouts", f"turnout {t} was driven from {was} (now "
+               f"{now or 'without indication'}) after {section} became occupied while its move waited in the queue", p)
+
+
 def red_lamp_transfer(ctx: Context) -> None:
     """Every signal with a red lamp: with its red lamp dark (both filaments), the automatic block signal in rear of it
     shows H, and no route ending at it opens (the signal would show nothing to the train it receives).

@@ -24,7 +24,7 @@ from .plan import Unit, UnitResult
 from .probe import Context, FirstFailure
 from .release import throat_checks
 from .routes import RouteTest
-from .station import power_up, red_lamp_transfer
+from .station import power_up, queued_move, red_lamp_transfer
 
 
 @dataclass
@@ -81,6 +81,8 @@ def run_unit(bench: Bench, unit: Unit, *, stop_at_first: bool = False) -> UnitRe
         line_direction(ctx)
     elif unit.item == "guide-area":
         guide_area(ctx)
+    elif unit.item == "queued-move":
+        queued_move(ctx)
     else:
         raise ValueError(f"unknown unit {unit}")
     return UnitResult(ctx.checks, ctx.failures, ctx.warnings, route)
