@@ -154,11 +154,19 @@ class RouteLifecycle:
 
     def _first_occupied(self, rs: RouteState) -> bool:
         """A movement is in the first section. With the approach clear an occupied first section is a track-circuit
-        fault (red band), as ``_keep_open`` judges it, not a movement entering: the route stays locked."""
+        fault (red band), as ``_keep_open`` judges it, not a movement entering: the route stays locked. Where the
+        signal was last given as a guide aspect over the first section showing occupied (the red band the guide is
+        for), that section says nothing, also once the aspect has closed: the movement has entered once it has
+        passed the signal, its approach clear again after a train was seen in it (noted here, as under the guide
+        aspect)."""
         r, il = rs.route, self.il
         if il.clear(r.sections[0]):
             return False
-        return not (r.approach and all(il.clear(s) for s in r.approach))
+        approach = any(not il.clear(s) for s in r.approach)
+        if not rs.guide_first_clear:
+            rs.guide_approach_seen = rs.guide_approach_seen or approach
+            return rs.guide_approach_seen and not approach
+        return not (r.approach and not approach)
 
     def _keep_open(self, rs: RouteState) -> None:
         il, r = self.il, rs.route
@@ -383,6 +391,7 @@ class RouteLifecycle:
         rs.stage = RouteStage.open
         rs.standing_memo = None
         rs.since = il.now
+        rs.guide_first_clear = True  # a main aspect is given only over a clear first section
         aspect = il.proven(r.signal, il.wanted_aspect(rs))
         il.out.set_aspect(r.signal, aspect)
         il.codes_dirty = True

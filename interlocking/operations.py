@@ -435,6 +435,9 @@ class Operator:
         if throat is None:
             return Result.refuse(f"no route is set from {signal} and its throat is not under guide total lock: "
                                  f"set the route first, or 'guide-lock {signal}'")
+        if self.il.power_up_locked:  # no movement authority before the operator has confirmed the station's state
+            return Result.refuse("guide refused: the station is locked since the interlocking started (上电锁闭): "
+                                 "give the power-up release first")
         why = self.il.line_against(signal)
         if why:
             return Result.refuse(f"guide refused: {why}")

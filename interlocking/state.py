@@ -33,7 +33,8 @@ class RouteState:
     was_occupied: list[bool] = field(default_factory=list)
     release_at: float | None = None  # when a time release completes
     overlap_release_at: float | None = None  # when the overlap releases, once the train reached the route's end
-    guide_first_clear: bool = False  # under a guide aspect: the first section was clear when it opened
+    guide_first_clear: bool = True  # the first section was clear when the signal was last given (always for a
+    # main aspect; under a guide aspect, not when it is the red band the guide is for)
     guide_approach_seen: bool = False  # under a guide aspect: the guided train has been seen approaching
     # section index -> when its section fault release (区故解) completes, given ahead of the movement in the route
     fault_release_at: dict[int, float] = field(default_factory=dict)

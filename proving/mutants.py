@@ -528,6 +528,17 @@ def _second_lamp_unproved(s: ExitStack) -> None:
     _patch(s, core.Core, "_dark", dark)
 
 
+def _guide_before_power_up_release(s: ExitStack) -> None:
+    def guide(real: Any) -> Any:
+        def careless(self: Any, signal: str, end: str | None = None, via: tuple[str, ...] = ()) -> Result:
+            if end is not None or self.il.route_of(signal) is not None:
+                return real(self, signal, end, via)  # type: ignore[no-any-return]
+            with mock.patch.object(self.il, "power_up_locked", False):
+                return real(self, signal, end, via)  # type: ignore[no-any-return]
+        return careless
+    _wrap(s, operations.Operator, "guide", guide)
+
+
 MUTANTS: tuple[Mutant, ...] = (
     Mutant("no-head-on-enemies", "the table leaves out opposing routes onto one track (train against train or "
            "shunting movement)", _no_head_on),
@@ -631,4 +642,6 @@ MUTANTS: tuple[Mutant, ...] = (
     Mutant("queued-move-under-a-vehicle", "a turnout move waiting in the queue starts without looking again at "
            "its section", _queued_move_under_a_vehicle),
     Mutant("second-lamp-unproved", "lamp proving looks at an aspect's first lamp only", _second_lamp_unproved),
+    Mutant("guide-before-power-up-release", "a guide aspect under guide total lock is given before the power-up "
+           "release", _guide_before_power_up_release),
 )

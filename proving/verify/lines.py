@@ -46,7 +46,7 @@ def line_direction(ctx: Context) -> None:
                 if result.ok:
                     p.do(f"cancel {r.signal}")
         for h in homes:
-            if not _shows_guide(ctx, h):
+            if not shows_guide(ctx, h):
                 continue
             p.do(f"guide-lock {h}")
             result = p.do(f"guide {h}")
@@ -56,7 +56,7 @@ def line_direction(ctx: Context) -> None:
                 p.do(f"cancel {h}")
             p.do(f"guide-unlock {h}")
         for h in homes:  # a guide aspect calls a train in from the line: the direction stays, no departure onto it
-            if not _shows_guide(ctx, h):
+            if not shows_guide(ctx, h):
                 continue
             q = Probe(ctx)
             q.do(f"guide-lock {h}")
@@ -84,7 +84,7 @@ def guide_area(ctx: Context) -> None:
     st = ctx.station
     guide = ctx.rules.aspects.guide
     for throat in ctx.table.throats:
-        if throat not in st.signals or not _shows_guide(ctx, throat):
+        if throat not in st.signals or not shows_guide(ctx, throat):
             continue
         subject = f"throat {throat}"
         inner, border = reach(ctx, throat)
@@ -146,7 +146,7 @@ def _opposing(ctx: Context, throat: str, border: set[str]) -> list[Route]:
             and r.category == "receiving" and r.sections and r.sections[-1] in border]
 
 
-def _shows_guide(ctx: Context, signal: str) -> bool:
+def shows_guide(ctx: Context, signal: str) -> bool:
     sig = ctx.station.signals[signal]
     return sig.kind in (SignalKind.home, SignalKind.route) and ctx.rules.aspects.can_show(
         ctx.rules.aspects.guide, [lamp.value for lamp in sig.lamps])

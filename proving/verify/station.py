@@ -7,13 +7,15 @@ from liansuo.interlocking.table import Route
 from liansuo.stations.schema import SignalKind
 
 from ..oracle.authority import Tracer
+from .lines import shows_guide
 from .probe import Context, Probe, route_line
 
 _STATION = ("throat", "station_track", "spur")
 
 
 def power_up(ctx: Context) -> None:
-    """After a restart every signal is closed, every section locked: routes and individual operation are refused;
+    """After a restart every signal is closed, every section locked: routes, guide aspects under guide total lock and
+    individual operation are refused;
     the power-up release is refused while a section shows occupied and then releases every section."""
     st = ctx.station
     subject = "power-up"
@@ -37,6 +39,14 @@ def power_up(ctx: Context) -> None:
         result = p.do(f"throw {t} {'reverse' if pos == 'normal' else 'normal'}")
         ctx.record(not result.ok, "power-up", subject, f"turnout {t} could be thrown before the power-up release: "
                    f"{result.message}", p)
+    for throat in ctx.table.throats:  # nor a guide aspect under guide total lock: it is a movement authority too
+        if throat in st.signals and shows_guide(ctx, throat) and p.do(f"guide-lock {throat}").ok:
+            result = p.do(f"guide {throat}")
+            p.run(1.0)
+            ctx.record(not result.ok and p.closed(throat), "power-up", subject, f"'guide {throat}' under guide "
+                       f"total lock before the power-up release: {result.message}; {throat} shows "
+                       f"{p.aspect(throat)}", p)
+            p.do(f"guide-unlock {throat}")
     if sections:
         p.do(f"occupy {sections[0]}")
         result = p.do("power-up-release")
