@@ -29,6 +29,7 @@ from liansuo.interlocking.locks import Lock
 from liansuo.interlocking.state import RouteStage
 from liansuo.simulation.sim import Simulation
 
+from ..judge.judge import TOLERANCE_S
 from ..oracle.watch import Watch
 
 
@@ -185,9 +186,11 @@ def judge_part(watch: Watch, clock: Clock) -> tuple[object, ...]:
     if watch.judge is None:
         return ()
     m = watch.judge.memory
+    unused = watch.judge.rules.guide_close_s + TOLERANCE_S  # when an unused guide aspect is owed closed
     claims = tuple(sorted((c.signal, c.kind, c.given, c.path, c.end_signal, c.entered, clock.timer(c.hold_until),
-                           c.guide_since is not None, c.guide_approached, c.guide_entered_at, c.guide_first_clear,
-                           c.overlap_owed, c.first_clear, c.guided) for c in m.claims.values()))
+                           clock.timer(None if c.guide_since is None else c.guide_since + unused),
+                           c.guide_approached, c.guide_entered_at, c.guide_first_clear, c.overlap_owed,
+                           c.first_clear, c.guided, c.total_lock) for c in m.claims.values()))
     holds = tuple(sorted((h.what, h.sections, clock.timer(h.until)) for h in m.holds))
     watched = {s for c in m.claims.values() for s in c.path} | {s for h in m.holds for s in h.sections}
     return (claims, holds, m.powered_up, _sorted(m.locked & watched), m.commanded, _sorted(m.active))

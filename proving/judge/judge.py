@@ -6,7 +6,8 @@ from the rule set's data: :mod:`.rules`) and what an observer of the console see
 accepted, the aspects lit, the sections shown locked, the track relays):
 
 - ``cancel``: a route whose signal has been given, with a train in its approach (接近锁闭), is never cancelled at
-  once (TB/T 3027: only a manual time release frees it);
+  once (TB/T 3027: only a manual time release frees it); a guide aspect under guide total lock has no route, and
+  cancelling it only closes it (the throat's lock stays until the operator's sealed guide-unlock);
 - ``release``: a manual time release (总人解) of an approach-locked route keeps the route locked for the whole
   delay (180 s train, 30 s shunting, or the signal's own), unless a train enters it;
 - ``released-occupied``: no section of a route's path is released while its track relay shows it occupied (but
@@ -62,6 +63,8 @@ class Claim:
     overlap_owed: bool = True  # the overlap time has not started yet
     first_clear: bool = True  # its first section showed clear when its signal was first given
     guided: bool = False  # a guide aspect was given for it: a guided train runs at sight, with no overlap
+    total_lock: bool = False  # a guide aspect under guide total lock: no route, the throat's lock holds the turnouts,
+    # and cancelling closes the aspect only (nothing is released that approach locking would keep)
 
 
 @dataclass
@@ -146,9 +149,13 @@ class Judge:
         if word in _SETS and len(words) >= 3:
             m.claims[sig] = Claim(sig, "shunt" if word == "shunt" else "train")
         elif word == "guide" and len(words) == 2 and sig not in m.claims:
-            m.claims[sig] = Claim(sig, "train")
+            m.claims[sig] = Claim(sig, "train", total_lock=True)
+        elif word == "guide" and len(words) == 2:  # given again over its route: a new aspect, its time starts now
+            c = m.claims[sig]
+            c.guide_since, c.guide_approached, c.guide_entered_at = now, False, None
+            c.guide_first_clear = not c.path or view.clear(c.path[0])
         elif word == "cancel" and sig in m.claims:
-            if self._approach_locked(m.claims[sig], view):
+            if self._approach_locked(m.claims[sig], view) and not m.claims[sig].total_lock:
                 out.append(self._finding("cancel", words, f"'cancel {sig}' was accepted at once with a train "
                                          f"approaching {sig} after its signal was given (接近锁闭)"))
             del m.claims[sig]

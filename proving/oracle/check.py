@@ -68,6 +68,7 @@ class _Held(Extent):
     operator: bool = False  # a guide aspect over turnouts without indication: the operator answers for the route
     guided: bool = False  # a guide aspect: its track circuits are not checked, the operator has looked at the way
     in_use: bool = False  # a movement under way (its signal has closed behind it)
+    guided_in: bool = False  # under way, entered on a guide aspect
 
 
 class Tables:
@@ -451,7 +452,8 @@ class Oracle:
             turnouts = {t: p for t, p in a.turnouts.items() if self.turnout_section.get(t) in rem}
             h = _Held(f"{a.signal} (in use)", a, rem | (set(a.overlap_sections) if overlap_held else set()), rem,
                       set(a.overlap_sections) if overlap_held else set(),
-                      {d for t in tracks for d, _ in self.st.crossings.get(t, ())}, operator=u.operator, in_use=True)
+                      {d for t in tracks for d, _ in self.st.crossings.get(t, ())}, operator=u.operator, in_use=True,
+                      guided_in=u.guided)
             for t, p in turnouts.items():
                 h.needed[t] = (p, "path")
             if overlap_held:
@@ -482,6 +484,10 @@ class Oracle:
             # movement already under way is the operator's; two signals given at once, guided or not, are the
             # interlocking's
             hazard = ((a.guided or a.operator) and b.in_use) or ((b.guided or b.operator) and a.in_use)
+            # a guide aspect given again over its route, the guided train still taken to be in it (its red band is
+            # no sign of where it is): the operator's, like any guide aspect towards a movement under way
+            hazard = hazard or (a.in_use and b.in_use and a.auth.signal == b.auth.signal
+                                 and (a.guided_in or b.guided_in))
             delayed = a.unsettled or b.unsettled
             # where the operator released a section of one of them by hand, what follows is on the operator's word
             hazard = hazard or bool(self.fault_released & {*a.sections, *b.sections})
