@@ -11,12 +11,15 @@ Add = Callable[..., argparse.ArgumentParser]
 def cmd_bench(args: argparse.Namespace) -> int:
     from .report import main  # the benchmark loads the whole simulation: only when it runs
 
-    return main(quick=args.quick, fmt=args.format, scale=args.scale)
+    return main(quick=args.quick, fmt=args.format, scale=args.scale, explore=args.explore)
 
 
 def register(add: Add) -> None:
     sp = add("bench", cmd_bench, "benchmark table building and the interlocking cycle (hub and jiaopei)")
     sp.add_argument("--quick", action="store_true", help="fewer cycles (under a minute)")
     sp.add_argument("--format", choices=("json", "text"), default="json", help="json (default) or text")
+    sp.add_argument("--explore", action="store_true", help="instead, the figures of 'liansuo explore': saturation, "
+                    "the depth reached on jiaopei in ten minutes, the mutation score of explore alone (the better part "
+                    "of an hour; with --quick minutes): docs/benchmark.md")
     sp.add_argument("--scale", action="store_true", help="also verify, soak and write the table of large hubs "
                     "(about a quarter of an hour in full on 2 cores; with --quick minutes): docs/benchmark.md")

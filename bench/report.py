@@ -191,7 +191,18 @@ def as_text(report: dict[str, Any]) -> str:
     return fit_all(lines)
 
 
-def main(quick: bool = False, fmt: str = "json", scale: bool = False) -> int:
+def main(quick: bool = False, fmt: str = "json", scale: bool = False, explore: bool = False) -> int:
+    if explore:  # its own run: it takes the better part of an hour in full
+        from .explore import ExploreSizes, measure_explore
+
+        figures = measure_explore(ExploreSizes.quick() if quick else ExploreSizes())
+        report: dict[str, Any] = {"benchmark": "liansuo explore", "mode": "quick" if quick else "full",
+                                  "machine": machine(), "explore": figures}
+        if fmt == "json":
+            print_report("bench", True, report)
+        else:
+            print(explore_text(figures))
+        return 0
     sizes = (ScaleSizes.quick() if quick else ScaleSizes()) if scale else None
     report = run_bench(quick=quick, scale=sizes, show_progress=None)
     if fmt == "json":
@@ -199,3 +210,19 @@ def main(quick: bool = False, fmt: str = "json", scale: bool = False) -> int:
     else:
         print(as_text(report))
     return 0
+
+
+def explore_text(f: dict[str, Any]) -> str:
+    lines = ["liansuo explore"]
+    for s in f["saturation"]:
+        lines.append(f"  {s['station']} (bounds {s['bounds']}): depth {s['depth']}, {s['states']:,} states in "
+                     f"{s['seconds']} s, {'saturated' if s['saturated'] else 'not saturated: ' + s['stopped']}")
+    d = f["depth"]
+    lines.append(f"  {d['station']} on {d['workers']} workers within {d['budget_s']:g} s: depth {d['depth']} in full, "
+                 f"{d['states']:,} states, {d['states_per_s_per_worker']:,} states/s per worker ({d['stopped']})")
+    ms = f["mutant_score"]
+    lines.append(f"  mutants found by explore alone: {ms['caught']} of {ms['mutants']}")
+    for m in f["mutants"]:
+        where = f"{m['station']} at depth {m['depth']} ({m['by']}: {m['finding']})" if m["found"] else "not found"
+        lines.append(f"    {m['mutant']:<34} {where}, {m['seconds']} s")
+    return fit_all(lines)

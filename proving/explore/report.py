@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 from dataclasses import asdict
+from pathlib import Path
 from typing import Any
 
 import yaml
@@ -26,6 +27,8 @@ def script(station: str, f: Found) -> str:
     """The shortest sequence that shows finding ``f``, as a test script that fails at its last step."""
     lines = [part for step in f.trace for part in step.line.split("; ")]
     v = f.violation
+    if Path(station).is_file():  # a file: found from wherever the script is written (a bundled name stays a name)
+        station = str(Path(station).resolve())
     head = (f"# liansuo explore {station}: {v.prop}, found at depth {len(f.trace)} (t = {v.t:g} s): {v.text}\n"
             "# The shortest sequence that shows it; with the safety oracle on, 'liansuo test FILE' fails at its "
             "last step.\n")
