@@ -52,6 +52,20 @@ def test_the_sound_interlocking_gives_explore_nothing_to_find_at_the_default_bou
     assert out.findings == {} and out.states > 1000  # type: ignore[attr-defined]
 
 
+def test_a_snapshot_takes_every_part_of_the_oracles_memory() -> None:
+    """What the oracle learns as it watches must go into a snapshot, or branches of the search leak into each other;
+    everything else it holds is the station's, fixed once it is made (a new attribute must be put in one list)."""
+    from liansuo.proving.explore.snapshot import _MEMORY
+    from liansuo.proving.oracle import Watch
+    from liansuo.simulation.sim import Simulation
+
+    fixed = {"aspects", "ceiling", "cycle_s", "doors", "flank", "kind", "lamps", "lines", "onto_track", "pair_of",
+             "reaction", "reader", "rear", "role", "section_of", "st", "tracer", "turnout_section",
+             "turnout_sections", "turnout_tracks"}
+    oracle = Watch(Simulation(MINIMAL), judge=True).oracle
+    assert set(vars(oracle)) - set(_MEMORY) == fixed
+
+
 def levels(station: str, depth: int, bounds: Bounds, reduce: bool) -> tuple[set[bytes], list[Trace]]:
     ex = Expander(load(station), load_rules(), bounds=bounds, reduce=reduce)
     seen, frontier, every = {ex.root_key}, [()], []

@@ -75,3 +75,19 @@ def test_the_judge_takes_its_times_from_the_station_file_and_the_rule_set_not_fr
     with mock.patch.object(operations.Operator, "release_delay", lambda self, r: 30.0):
         found = watched(str(station), lines)
     assert [(v.source, v.prop) for v in found] == [("judge", "release")] and "30.0 s before" in found[0].text
+
+
+@pytest.mark.parametrize("lines", [
+    # a guided train entering as its guide aspect lights: it has entered, not stood on a red band
+    "occupy IAG; run 0.25s; throw 1 reverse; run 0.75s; guide X XI; run 4s; occupy 1DG; run 0.75s; vacate 1DG; "
+    "run 0.25s; fault-release 1DG; run 1s",
+    # the guide aspect given again over its route after its red lamp failed: the operator's (a hazard), not two
+    # movements the interlocking let into one route
+    "occupy IAG; occupy 1DG; run 0.5s; guide X XI; run 0.75s; fault filament X lamp=H which=both; run 0.75s; "
+    "repair filament X; run 0.5s; guide X; run 0.5s; fault filament X lamp=H which=both; run 0.75s",
+    # cancelling a guide aspect under guide total lock with a train approaching: no route to release
+    "guide-lock X; run 0.25s; guide X; run 0.5s; occupy IAG; run 0.25s; cancel X; run 0.5s",
+])
+def test_sequences_explore_found_on_the_sound_interlocking_are_not_violations(lines: str) -> None:
+    """Each of these was a finding of 'liansuo explore' on the minimal station that was the checks' mistake."""
+    assert watched(MINIMAL, lines) == []

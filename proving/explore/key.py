@@ -174,7 +174,7 @@ def oracle_part(sim: Simulation, watch: Watch, clock: Clock) -> tuple[object, ..
     return (open_, _items(o.shown), in_use, _sorted(o.closed), _sorted(o.allowed & o.closed), _items(o.pending),
             _sorted(o.active), _items(o.was_moving), _sorted(o.approached), _sorted(o.operated),
             _sorted(o.guide_locked), _sorted(o.fault_released & {s for u in o.in_use for s in u.sections}),
-            _sorted(o.turnout_sections_occupied))
+            _sorted(o.turnout_sections_occupied), _sorted(o.guide_given))
 
 
 def _sorted(xs: Iterable[str]) -> tuple[str, ...]:
@@ -193,4 +193,5 @@ def judge_part(watch: Watch, clock: Clock) -> tuple[object, ...]:
                            c.first_clear, c.guided, c.total_lock) for c in m.claims.values()))
     holds = tuple(sorted((h.what, h.sections, clock.timer(h.until)) for h in m.holds))
     watched = {s for c in m.claims.values() for s in c.path} | {s for h in m.holds for s in h.sections}
-    return (claims, holds, m.powered_up, _sorted(m.locked & watched), m.commanded, _sorted(m.active))
+    return (claims, holds, m.powered_up, _sorted(m.locked & watched), m.commanded, _sorted(m.active),
+            _sorted(m.occupied_before))

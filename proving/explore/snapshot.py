@@ -92,7 +92,7 @@ def restore(sim: Simulation, watch: Watch, shared: Shared, data: bytes) -> None:
 
 
 _MEMORY = ("open", "shown", "in_use", "closed", "allowed", "pending", "active", "was_moving", "approached",
-           "operated", "guide_locked", "fault_released", "turnout_sections_occupied", "now")
+           "operated", "guide_locked", "fault_released", "turnout_sections_occupied", "guide_given", "now")
 
 
 def _oracle_memory(oracle: Any) -> dict[str, Any]:

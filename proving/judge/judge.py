@@ -84,6 +84,9 @@ class JudgeMemory:
     locked: set[str] = field(default_factory=set)  # sections shown locked at the last check
     commanded: bool = False  # a command that releases by hand was accepted since the last check
     active: set[str] = field(default_factory=set)  # findings of the last check: reported when they start, once
+    # sections showing occupied when a claim was made and at each check while one waits for its signal: a first
+    # section occupied only since then is a movement entering as the aspect lit, not the red band it was given over
+    occupied_before: frozenset[str] = frozenset()
 
 
 class Tables:
@@ -148,8 +151,10 @@ class Judge:
         sig = words[1] if len(words) > 1 else ""
         if word in _SETS and len(words) >= 3:
             m.claims[sig] = Claim(sig, "shunt" if word == "shunt" else "train")
+            m.occupied_before = self._occupied(view)
         elif word == "guide" and len(words) == 2 and sig not in m.claims:
             m.claims[sig] = Claim(sig, "train", total_lock=True)
+            m.occupied_before = self._occupied(view)
         elif word == "guide" and len(words) == 2:  # given again over its route: a new aspect, its time starts now
             c = m.claims[sig]
             c.guide_since, c.guide_approached, c.guide_entered_at = now, False, None
@@ -199,7 +204,7 @@ class Judge:
         m = self.memory
         out: list[Finding] = []
         if not m.claims and not m.holds and not m.active:
-            m.locked, m.commanded = set(), False
+            m.locked, m.commanded, m.occupied_before = set(), False, frozenset()
             return out
         # only what the claims and holds look at: a hub has hundreds of sections and signals
         watched = {s for c in m.claims.values() for s in c.path} | {s for h in m.holds for s in h.sections}
@@ -213,7 +218,7 @@ class Judge:
                 a = self.tables.tracer.trace(sig, "shunt" if aspect == self.rules.aspects.shunt else "train",
                                              view.rails)
                 if not c.given:
-                    c.first_clear = not a.sections or view.clear(a.sections[0])
+                    c.first_clear = self._first_clear(a.sections, view)
                 c.given, c.path, c.end_signal = True, tuple(a.sections), a.end_signal
                 c.guided = c.guided or aspect == guide
             if c.given and c.path and not c.entered and not view.clear(c.path[0]) and (
@@ -240,6 +245,7 @@ class Judge:
         watched = {s for c in m.claims.values() for s in c.path} | {s for h in m.holds for s in h.sections}
         m.locked = {s for s in watched if view.section_locked(s)}
         m.commanded = False
+        m.occupied_before = self._occupied(view) if any(not c.given for c in m.claims.values()) else frozenset()
         new = [f for f in out if f.key not in m.active]
         m.active = {f.key for f in out}
         return new
@@ -270,7 +276,7 @@ class Judge:
         approach = any(not view.clear(s) for s in self.tables.extent.get(c.signal, ()))
         if c.guide_since is None:
             c.guide_since = now
-            c.guide_first_clear = not c.path or view.clear(c.path[0])
+            c.guide_first_clear = self._first_clear(c.path, view)
         if approach:
             c.guide_approached = True
         out = []
@@ -300,6 +306,14 @@ class Judge:
             self.memory.holds.append(Hold(f"the overlap of {c.signal} beyond {c.end_signal}", sections, now + time))
 
     # ---- helpers -----------------------------------------------------------------------------------------------
+    def _occupied(self, view: FieldView) -> frozenset[str]:
+        return frozenset(s for s in self.tables.station_sections if not view.clear(s))
+
+    def _first_clear(self, path: tuple[str, ...] | list[str], view: FieldView) -> bool:
+        """The first section of ``path`` was clear when its signal was given: clear now, or occupied only since the
+        last look (the movement entered as the aspect lit)."""
+        return not path or view.clear(path[0]) or path[0] not in self.memory.occupied_before
+
     def _approach_locked(self, c: Claim, view: FieldView) -> bool:
         return c.given and any(not view.clear(s) for s in self.tables.extent.get(c.signal, ()))
 

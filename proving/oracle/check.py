@@ -133,6 +133,7 @@ class Oracle:
         self.open: dict[str, Authority] = {}  # signal -> its authority at the last check
         self.shown: dict[str, str] = {}  # signal -> the proceed aspect it showed at the last check
         self.in_use: list[InUse] = []
+        self.guide_given: set[str] = set()  # signals open on an authority given as a guide aspect
         self.closed: set[str] = set()  # signals that closed and have not been reopened by the operator since
         self.allowed: set[str] = set()  # signals the operator may open again (an accepted route, reopen or guide)
         self.pending: dict[str, int] = {}  # delayed finding -> consecutive checks it has lasted
@@ -220,7 +221,9 @@ class Oracle:
             rear = self.rear[sig]
             entered = rear is None or sig in self.approached or not view.clear(rear)
             if entered and not view.clear(a.sections[0]):
-                self._start_in_use(a, view, sig in self.operated, guided=self.shown[sig] == self.aspects.guide)
+                # given as a guide aspect, whatever its lamps showed last (HB with its red lamp dark shows B alone)
+                self._start_in_use(a, view, sig in self.operated, guided=sig in self.guide_given)
+            self.guide_given.discard(sig)
             self.operated.discard(sig)
             if self.kind[sig] is not SignalKind.block:
                 self.closed.add(sig)
@@ -235,6 +238,7 @@ class Oracle:
             kind = "shunt" if aspect == self.aspects.shunt else "train"
             self.open[sig] = self._trace(sig, kind, view)
         self.shown = shown
+        self.guide_given |= {sig for sig, aspect in shown.items() if aspect == self.aspects.guide}
         self.approached = {sig for sig in shown if (rear := self.rear[sig]) is not None and not view.clear(rear)}
         return shown
 
