@@ -379,6 +379,17 @@ def _time_release_ends_on_any_occupancy(s: ExitStack) -> None:
     _wrap(s, lifecycle.RouteLifecycle, "_time_release", ends)
 
 
+def _patched_during(stack: ExitStack, owner: object, method: str, target: Callable[[Any], object], attr: str,
+                    value: Any) -> None:
+    """``owner.method`` runs with ``attr`` of ``target(self)`` replaced by ``value``: a check it asks left out."""
+    def make(real: Any) -> Any:
+        def careless(self: Any, *args: Any) -> Any:
+            with mock.patch.object(target(self), attr, value):
+                return real(self, *args)
+        return careless
+    _wrap(stack, owner, method, make)
+
+
 def _direction_change_ignores_guide(s: ExitStack) -> None:
     def change(real: Any) -> Any:
         def careless(self: Any, link: str, direction: str) -> Result:
@@ -462,21 +473,12 @@ def _guide_never_times_out(s: ExitStack) -> None:
 
 
 def _power_up_release_over_occupancy(s: ExitStack) -> None:
-    def release(real: Any) -> Any:
-        def careless(self: Any) -> Result:
-            with mock.patch.object(self.il, "clear", lambda section: True):
-                return real(self)  # type: ignore[no-any-return]
-        return careless
-    _wrap(s, operations.Operator, "power_up_release", release)
+    _patched_during(s, operations.Operator, "power_up_release", lambda op: op.il, "clear", lambda section: True)
 
 
 def _fault_release_of_station_track(s: ExitStack) -> None:
-    def release(real: Any) -> Any:
-        def careless(self: Any, section: str) -> Result:
-            with mock.patch.object(self.il.station, "is_station_track", lambda sec: False):
-                return real(self, section)  # type: ignore[no-any-return]
-        return careless
-    _wrap(s, operations.Operator, "fault_release", release)
+    _patched_during(s, operations.Operator, "fault_release", lambda op: op.il.station, "is_station_track",
+                    lambda section: False)
 
 
 def _fault_release_under_open_signal(s: ExitStack) -> None:
@@ -497,12 +499,7 @@ def _fault_release_under_open_signal(s: ExitStack) -> None:
 
 
 def _reopen_without_conditions(s: ExitStack) -> None:
-    def reopen(real: Any) -> Any:
-        def careless(self: Any, signal: str) -> Result:
-            with mock.patch.object(self.il, "open_blocker", lambda rs: ""):
-                return real(self, signal)  # type: ignore[no-any-return]
-        return careless
-    _wrap(s, operations.Operator, "reopen", reopen)
+    _patched_during(s, operations.Operator, "reopen", lambda op: op.il, "open_blocker", lambda rs: "")
 
 
 def _queued_move_under_a_vehicle(s: ExitStack) -> None:

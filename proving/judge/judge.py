@@ -84,8 +84,8 @@ class JudgeMemory:
     locked: set[str] = field(default_factory=set)  # sections shown locked at the last check
     commanded: bool = False  # a command that releases by hand was accepted since the last check
     active: set[str] = field(default_factory=set)  # findings of the last check: reported when they start, once
-    # sections showing occupied when a claim was made and at each check while one waits for its signal: a first
-    # section occupied only since then is a movement entering as the aspect lit, not the red band it was given over
+    # the first sections of claims waiting for their signal that showed occupied when the claim was made and at
+    # each check since: one occupied only since then is a movement entering as the aspect lit, not a red band
     occupied_before: frozenset[str] = frozenset()
 
 
@@ -98,6 +98,9 @@ class Tables:
         self.reader = LampReader(rules.aspects)
         self.steep = steep_homes(station, rules)
         self.station_sections = tuple(s for s, sec in station.sections.items() if sec.role in _STATION)
+        # the first section of any authority a signal gives: the one a movement passing it enters
+        self.entry = {sig.id: station.tracks[station.signal_entry_track(sig.id)].section
+                      for sig in station.model.signals}
         self.overlaps: dict[tuple[str, str], tuple[tuple[str, ...], float]] = {}  # (home, end) -> sections, time
         for sig in station.model.signals:
             if sig.kind is not SignalKind.home:
@@ -307,7 +310,9 @@ class Judge:
 
     # ---- helpers -----------------------------------------------------------------------------------------------
     def _occupied(self, view: FieldView) -> frozenset[str]:
-        return frozenset(s for s in self.tables.station_sections if not view.clear(s))
+        """The first sections of the claims waiting for their signal that show occupied."""
+        entries = {self.tables.entry[c.signal] for c in self.memory.claims.values() if not c.given}
+        return frozenset(s for s in entries if not view.clear(s))
 
     def _first_clear(self, path: tuple[str, ...] | list[str], view: FieldView) -> bool:
         """The first section of ``path`` was clear when its signal was given: clear now, or occupied only since the
