@@ -8,15 +8,11 @@ STAMP := $(VENV)/.installed
 
 # Reinstall only when pyproject.toml changed since the last install. The sumo extra (libsumo, eclipse-sumo, about
 # 230 MB) is installed too where it can be; where it cannot, the SUMO engine's tests skip and say why.
-# QUIET_BUILD silences setuptools' one notice on an editable install of a flat layout ("be careful with folders in
-# your working directory with the same name as your package": liansuo/ is that folder, by design); every other
-# warning of the build still shows.
-QUIET_BUILD := PYTHONWARNINGS="ignore:Editable installation"
-$(STAMP): pyproject.toml
+$(STAMP): pyproject.toml setup.py
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
-	$(QUIET_BUILD) $(BIN)/python -m pip install --quiet -e '.[test]'
-	$(QUIET_BUILD) $(BIN)/python -m pip install --quiet -e '.[sumo]' > $(VENV)/sumo-install.log 2>&1 \
+	$(BIN)/python -m pip install --quiet -e '.[test]'
+	$(BIN)/python -m pip install --quiet -e '.[sumo]' > $(VENV)/sumo-install.log 2>&1 \
 		|| echo "notice: the sumo extra (libsumo, eclipse-sumo) could not be installed, the SUMO engine tests will skip (see $(VENV)/sumo-install.log)"
 	touch $(STAMP)
 
@@ -34,7 +30,7 @@ test: $(STAMP)
 # modules either way (tests/conftest.py) and tests/test_native.py compares the two (pytest -m native).
 native: $(STAMP)
 	$(BIN)/python -m pip install --quiet --upgrade 'setuptools>=77' 'mypy>=1.10'
-	LIANSUO_NATIVE=1 $(QUIET_BUILD) $(BIN)/python -m pip install --quiet --no-build-isolation --no-deps -e .
+	LIANSUO_NATIVE=1 $(BIN)/python -m pip install --quiet --no-build-isolation --no-deps -e .
 
 # The native wheel built from a copy of the checkout, each command's answer compared with the Python sources'.
 test-native: $(STAMP)
@@ -46,5 +42,5 @@ lint: $(STAMP)
 	$(BIN)/mypy
 
 clean:
-	rm -rf $(VENV) build *.egg-info .pytest_cache .mypy_cache .ruff_cache
+	rm -rf $(VENV) build src/*.egg-info .pytest_cache .mypy_cache .ruff_cache
 	find . -path ./.venv -prune -o -name '*.so' -print -exec rm -f {} +

@@ -38,7 +38,7 @@ def native() -> dict[str, object]:
         raise SystemExit("a native build (LIANSUO_NATIVE=1) compiles with mypyc, which type-checks the modules first: "
                          "build it with --no-build-isolation in an environment with mypy, setuptools>=77 and "
                          "liansuo's dependencies installed (`make native` does all of it; docs/native.md)") from None
-    return {"ext_modules": mypycify([f"liansuo/{m}.py" for m in NATIVE], opt_level="3")}
+    return {"ext_modules": mypycify([f"src/liansuo/{m}.py" for m in NATIVE], opt_level="3")}
 
 
 setup(**native())

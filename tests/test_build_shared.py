@@ -31,8 +31,9 @@ from liansuo.stations.loader import load, load_text
 from liansuo.stations.station import Station
 
 ROOT = Path(__file__).resolve().parents[1]
-DANXIAN = str(ROOT / "examples" / "stations" / "danxian.yaml")  # an axle-counter section on its line
-MINIMAL = (ROOT / "examples" / "stations" / "minimal.yaml").read_text(encoding="utf-8")
+PKG = ROOT / "src" / "liansuo"
+DANXIAN = str(PKG / "examples" / "stations" / "danxian.yaml")  # an axle-counter section on its line
+MINIMAL = (PKG / "examples" / "stations" / "minimal.yaml").read_text(encoding="utf-8")
 
 # what each station's harsh script does to its simulation: routes, occupancy, turnouts thrown, a train, and a fault of
 # every kind the station has equipment for; the mild script is an ordinary working of the station

@@ -16,7 +16,7 @@ from liansuo.simulation.sim import Simulation
 from liansuo.simulation.trains.cabsignal import CabReader
 from liansuo.stations.loader import load
 
-EXAMPLES = Path(__file__).parent.parent / "examples"
+EXAMPLES = Path(__file__).parent.parent / "src" / "liansuo" / "examples"
 
 
 def test_scenario_shows_the_atp_braking_on_a_wrong_carrier(capsys: pytest.CaptureFixture[str]) -> None:

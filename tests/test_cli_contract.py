@@ -16,10 +16,11 @@ from liansuo.simulation.sim import Simulation
 from liansuo.stations.jsonreport import SCHEMAS, version
 
 ROOT = Path(__file__).resolve().parent.parent
-STATION = ROOT / "examples" / "stations" / "minimal.yaml"
-SCRIPT = ROOT / "examples" / "scripts" / "jiaopei-interlocking-test.yaml"
-SCENARIO = ROOT / "examples" / "scenarios" / "jiaopei-receive-depart.yaml"
-EXERCISE = ROOT / "liansuo" / "exercises" / "jiaopei-broken-rail-IG.yaml"
+PKG = ROOT / "src" / "liansuo"
+STATION = PKG / "examples" / "stations" / "minimal.yaml"
+SCRIPT = PKG / "examples" / "scripts" / "jiaopei-interlocking-test.yaml"
+SCENARIO = PKG / "examples" / "scenarios" / "jiaopei-receive-depart.yaml"
+EXERCISE = PKG / "exercises" / "jiaopei-broken-rail-IG.yaml"
 
 
 def run(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:
@@ -153,7 +154,7 @@ def test_a_missing_script_is_bad_input_and_nothing_runs(tmp_path: Path, capsys: 
 
 
 def test_failed_checks_are_1_and_say_so_on_stderr(capsys: pytest.CaptureFixture[str]) -> None:
-    broken = ROOT / "examples" / "broken" / "gaotie-no-diamond-protection.yaml"
+    broken = PKG / "examples" / "broken" / "gaotie-no-diamond-protection.yaml"
     code, out, err = run(capsys, "verify", str(broken), "--no-pairs", "--route", "X-XI(BA1)")
     assert code == 1 and "FAIL" in out
     assert re.fullmatch(r"liansuo verify: \d+ checks? failed on gaotie-no-diamond-protection\n", err)
@@ -219,11 +220,11 @@ def test_every_bundled_and_example_file_is_its_own_kind() -> None:
 
     kinds = {"stations": "station", "scripts": "script", "scenarios": "scenario", "broken": "station"}
     for folder, kind in kinds.items():
-        for path in (ROOT / "examples" / folder).glob("*.yaml"):
+        for path in (PKG / "examples" / folder).glob("*.yaml"):
             assert kind_of_file(path) == kind, path
-    for path in (ROOT / "stations" / "library").glob("*.yaml"):
+    for path in (PKG / "stations" / "library").glob("*.yaml"):
         assert kind_of_file(path) == "station", path
-    for path in (ROOT / "liansuo" / "exercises").glob("*.yaml"):
+    for path in (PKG / "exercises").glob("*.yaml"):
         assert kind_of_file(path) == "exercise", path
 
 

@@ -14,7 +14,8 @@ from liansuo.cli.main import main
 from liansuo.stations.library import bundled
 
 ROOT = Path(__file__).resolve().parent.parent
-MINIMAL = ROOT / "examples" / "stations" / "minimal.yaml"
+PKG = ROOT / "src" / "liansuo"
+MINIMAL = PKG / "examples" / "stations" / "minimal.yaml"
 
 
 def run(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:

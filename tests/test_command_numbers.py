@@ -88,5 +88,5 @@ def test_a_scenario_until_past_a_day_is_refused(tmp_path: Any, capsys: pytest.Ca
     code = main(["run", str(path)])
     err = capsys.readouterr().err
     assert code == 3 and "until must be from 0 to 86400 s, not '9999999h'" in err
-    assert main(["run", "examples/scenarios/jiaopei-receive-depart.yaml", "--until", "48h"]) == 2
+    assert main(["run", "src/liansuo/examples/scenarios/jiaopei-receive-depart.yaml", "--until", "48h"]) == 2
     assert "--until must be from 0 to 86400 s, not '48h'" in capsys.readouterr().err

@@ -14,9 +14,10 @@ from liansuo.stations.loader import load_text
 from liansuo.stations.source import StationError
 
 ROOT = Path(__file__).resolve().parent.parent
-SHUANGXIAN = (ROOT / "examples" / "stations" / "shuangxian.yaml").read_text(encoding="utf-8")
-JIAOCHA = (ROOT / "examples" / "stations" / "jiaocha.yaml").read_text(encoding="utf-8")
-DOUBLESLIP = (ROOT / "examples" / "stations" / "doubleslip.yaml").read_text(encoding="utf-8")
+PKG = ROOT / "src" / "liansuo"
+SHUANGXIAN = (PKG / "examples" / "stations" / "shuangxian.yaml").read_text(encoding="utf-8")
+JIAOCHA = (PKG / "examples" / "stations" / "jiaocha.yaml").read_text(encoding="utf-8")
+DOUBLESLIP = (PKG / "examples" / "stations" / "doubleslip.yaml").read_text(encoding="utf-8")
 
 
 def refusal(text: str) -> str:

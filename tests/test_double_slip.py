@@ -22,7 +22,8 @@ from liansuo.stations.source import StationError
 from liansuo.tui.layout import build_layout
 
 ROOT = Path(__file__).resolve().parent.parent
-EXAMPLE = ROOT / "examples" / "stations" / "doubleslip.yaml"
+PKG = ROOT / "src" / "liansuo"
+EXAMPLE = PKG / "examples" / "stations" / "doubleslip.yaml"
 TEXT = EXAMPLE.read_text(encoding="utf-8")
 ENTRY = "  - {id: 21-27, at: 740, length: 34, number: 9, machine: ZD6, section: 21-27DG, slips: [[21, 23], [25, 27]]}"
 

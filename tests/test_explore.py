@@ -21,8 +21,9 @@ from liansuo.rules import load_rules
 from liansuo.stations.loader import load
 
 ROOT = Path(__file__).resolve().parent.parent
-MINIMAL = str(ROOT / "examples" / "stations" / "minimal.yaml")
-PODAO = str(ROOT / "examples" / "stations" / "podao.yaml")
+PKG = ROOT / "src" / "liansuo"
+MINIMAL = str(PKG / "examples" / "stations" / "minimal.yaml")
+PODAO = str(PKG / "examples" / "stations" / "podao.yaml")
 SMALL = Bounds(routes=1, faults=0, occupied=1, turnout_marks=0, guide_locks=0)
 
 

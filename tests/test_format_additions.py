@@ -21,7 +21,8 @@ from liansuo.stations.rules import design_rules
 from liansuo.stations.source import StationError
 
 ROOT = Path(__file__).resolve().parent.parent
-EXAMPLES = ROOT / "examples" / "stations"
+PKG = ROOT / "src" / "liansuo"
+EXAMPLES = PKG / "examples" / "stations"
 DANXIAN = (EXAMPLES / "danxian.yaml").read_text(encoding="utf-8")
 MINIMAL = (EXAMPLES / "minimal.yaml").read_text(encoding="utf-8")
 SHUANGXIAN = (EXAMPLES / "shuangxian.yaml").read_text(encoding="utf-8")

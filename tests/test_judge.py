@@ -19,8 +19,9 @@ from liansuo.proving.oracle.watch import Violation
 from liansuo.simulation.sim import Simulation
 
 ROOT = Path(__file__).resolve().parent.parent
-MINIMAL = str(ROOT / "examples" / "stations" / "minimal.yaml")
-DANXIAN = str(ROOT / "examples" / "stations" / "danxian.yaml")
+PKG = ROOT / "src" / "liansuo"
+MINIMAL = str(PKG / "examples" / "stations" / "minimal.yaml")
+DANXIAN = str(PKG / "examples" / "stations" / "danxian.yaml")
 
 CASES = [
     ("cancel-ignores-approach", MINIMAL, "route X XI; run 3s; occupy IAG; run 1s; cancel X; run 1s", "cancel"),

@@ -14,7 +14,7 @@ from conftest import TWO_TESTS_SCRIPT
 from liansuo.cli.main import main
 
 XSD = Path(__file__).parent / "data" / "junit-10.xsd"
-EXAMPLE = Path(__file__).parent.parent / "examples" / "scripts"
+EXAMPLE = Path(__file__).parent.parent / "src" / "liansuo" / "examples" / "scripts"
 
 
 

@@ -1,13 +1,16 @@
-"""The repository's layout: a folder per layer at the top, installed and linked as ``liansuo.<layer>``."""
+"""The repository's layout: one tree, ``src/liansuo/<layer>``, each module with one name, ``liansuo.<layer>...``."""
 
 from __future__ import annotations
 
 import ast
+import subprocess
+import sys
 from pathlib import Path
 
 import networkx as nx
 
 ROOT = Path(__file__).resolve().parents[1]
+PKG = ROOT / "src" / "liansuo"
 LAYERS = ("rules", "stations", "circuits", "interlocking", "simulation", "proving", "bench", "tui", "server",
           "remote", "cli")
 # the floor of each layer: a module imports only from its own layer or from a lower floor (README.md, "Layout")
@@ -17,18 +20,25 @@ FLOOR = {"rules": 0, "stations": 1, "circuits": 2, "interlocking": 2, "simulatio
 # console (tui) on the server's seats, so it stands above both
 
 
-def test_every_layer_is_linked_into_the_package() -> None:
+def test_every_layer_is_a_folder_of_the_package_and_nothing_is_linked() -> None:
     for layer in LAYERS:
-        link = ROOT / "liansuo" / layer
-        assert link.is_symlink(), f"liansuo/{layer} should be a link to ../{layer}"
-        assert link.resolve() == (ROOT / layer).resolve()
-        assert (ROOT / layer / "__init__.py").is_file()
+        assert (PKG / layer / "__init__.py").is_file(), f"src/liansuo/{layer} should be a package"
+        assert not (ROOT / layer).exists(), f"{layer}/ at the top would give its modules a second name"
+    tracked = subprocess.run(["git", "ls-files", "-s"], cwd=ROOT, capture_output=True, text=True, check=True).stdout
+    links = [line.split("\t", 1)[1] for line in tracked.splitlines() if line.startswith("120000")]
+    assert not links, f"symbolic links break a checkout without them (core.symlinks=false): {links}"
+
+
+def test_a_layer_has_no_bare_name_from_the_repository_root() -> None:
+    code = f"import importlib.util as u; print([n for n in {LAYERS!r} if u.find_spec(n)])"
+    out = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, check=True).stdout
+    assert out.strip() == "[]", f"importable without liansuo. from the checkout: {out.strip()}"
 
 
 def test_no_module_imports_a_layer_by_its_bare_name() -> None:
     """``import stations`` works in the checkout only (the top folder is on sys.path there), never installed."""
     bare = []
-    files = [p for layer in LAYERS for p in (ROOT / layer).rglob("*.py")] + list((ROOT / "tests").rglob("*.py"))
+    files = [p for layer in LAYERS for p in (PKG / layer).rglob("*.py")] + list((ROOT / "tests").rglob("*.py"))
     for path in files:
         for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
             names = ([a.name for a in node.names] if isinstance(node, ast.Import)
@@ -43,8 +53,8 @@ def _imports() -> nx.DiGraph:
     """Module -> module it imports (anywhere in the file: at the top, in a function, for type checking only)."""
     files: dict[str, Path] = {}
     for layer in LAYERS:
-        for p in (ROOT / layer).rglob("*.py"):
-            parts = p.relative_to(ROOT).with_suffix("").parts
+        for p in (PKG / layer).rglob("*.py"):
+            parts = p.relative_to(PKG).with_suffix("").parts
             files[".".join(("liansuo", *(parts[:-1] if parts[-1] == "__init__" else parts)))] = p
     graph = nx.DiGraph()
     for mod, path in files.items():

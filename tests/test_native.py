@@ -29,9 +29,10 @@ import pytest
 pytestmark = pytest.mark.native
 
 ROOT = Path(__file__).resolve().parents[1]
+PKG = ROOT / "src" / "liansuo"
 NOT_COPIED_AT_TOP = {".venv", ".git", "build", "dist", "tests", "docs"}
 NOT_COPIED = {"__pycache__", ".pytest_cache", ".mypy_cache", ".ruff_cache", ".hypothesis"}
-STATIONS = ["jiaopei", "gaotie", "depot", *(str(ROOT / "examples" / "stations" / f"{name}.yaml")
+STATIONS = ["jiaopei", "gaotie", "depot", *(str(PKG / "examples" / "stations" / f"{name}.yaml")
                                             for name in ("danxian", "shuangxian", "doubleslip", "minimal"))]
 TIMINGS = {"elapsed_s", "seconds"}
 
@@ -142,16 +143,16 @@ def test_soak_runs_the_same(installed: Path, tmp_path: Path, station: str, seed:
 
 
 def test_example_scripts_pass_the_same(installed: Path, tmp_path: Path) -> None:
-    scripts = sorted(str(p) for p in (ROOT / "examples" / "scripts").glob("*.yaml"))
+    scripts = sorted(str(p) for p in (PKG / "examples" / "scripts").glob("*.yaml"))
     native, pure = both(installed, ["-m", "liansuo.cli", "test", *scripts, "--format", "json"], tmp_path)
     assert native == pure
     assert pure["passed"] > 0 and pure["failed"] == 0
 
 
-@pytest.mark.parametrize("scenario", sorted(p.name for p in (ROOT / "examples" / "scenarios").glob("*.yaml")))
+@pytest.mark.parametrize("scenario", sorted(p.name for p in (PKG / "examples" / "scenarios").glob("*.yaml")))
 def test_scenarios_run_the_same(installed: Path, tmp_path: Path, scenario: str) -> None:
     """Trains, faults and commands in time: every event of the log, at the same time, with the same text."""
-    native, pure = both(installed, ["-m", "liansuo.cli", "run", str(ROOT / "examples" / "scenarios" / scenario),
+    native, pure = both(installed, ["-m", "liansuo.cli", "run", str(PKG / "examples" / "scenarios" / scenario),
                                     "--format", "json"], tmp_path)
     assert native == pure
     assert pure["events"]

@@ -23,13 +23,14 @@ from liansuo.simulation.sim import Simulation
 from liansuo.stations.loader import load
 
 ROOT = Path(__file__).resolve().parent.parent
-SHUANGXIAN = str(ROOT / "examples" / "stations" / "shuangxian.yaml")
-DANXIAN = str(ROOT / "examples" / "stations" / "danxian.yaml")
-BROKEN = ROOT / "examples" / "broken" / "gaotie-no-diamond-protection.yaml"
+PKG = ROOT / "src" / "liansuo"
+SHUANGXIAN = str(PKG / "examples" / "stations" / "shuangxian.yaml")
+DANXIAN = str(PKG / "examples" / "stations" / "danxian.yaml")
+BROKEN = PKG / "examples" / "broken" / "gaotie-no-diamond-protection.yaml"
 
 
 # ---- independence ---------------------------------------------------------------------------------------------------
-ORACLE = ROOT / "liansuo" / "proving" / "oracle"
+ORACLE = PKG / "proving" / "oracle"
 
 
 def imported(path: Path) -> set[str]:
@@ -38,7 +39,7 @@ def imported(path: Path) -> set[str]:
     for node in ast.walk(tree):
         if isinstance(node, ast.If) and getattr(node.test, "id", "") == "TYPE_CHECKING":
             node.body = []
-    package = path.relative_to(ROOT).parent.parts  # ('liansuo', 'proving', 'oracle')
+    package = path.relative_to(ROOT / "src").parent.parts  # ("liansuo", "proving", "oracle")
     out: set[str] = set()
     for node in ast.walk(tree):
         if isinstance(node, ast.ImportFrom):
@@ -67,7 +68,7 @@ def test_the_oracle_imports_nothing_of_the_interlocking_and_of_the_rules_only_th
             assert not module.startswith(("liansuo.proving.verify", "liansuo.proving.soak",
                                           "liansuo.proving.mutants")), (path.name, module)
     assert "liansuo.rules" in seen
-    for path in sorted((ROOT / "liansuo" / "rules").glob("*.py")):
+    for path in sorted((PKG / "rules").glob("*.py")):
         below = {m for m in imported(path) if m.startswith("liansuo.") and not m.startswith("liansuo.rules")}
         assert not below, f"rules/{path.name} imports {below}: the rule set is data, it imports no layer"
     assert "liansuo.stations.station" in seen and "liansuo.proving.oracle.authority" in seen  # imports were read

@@ -18,7 +18,8 @@ from liansuo.cli.main import main
 from liansuo.simulation.sim import Simulation
 
 ROOT = Path(__file__).resolve().parents[1]
-MINIMAL = (ROOT / "examples" / "stations" / "minimal.yaml").read_text(encoding="utf-8")
+PKG = ROOT / "src" / "liansuo"
+MINIMAL = (PKG / "examples" / "stations" / "minimal.yaml").read_text(encoding="utf-8")
 BAD_BALLAST = [0.0, -1.0, math.nan]
 
 

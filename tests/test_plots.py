@@ -21,7 +21,8 @@ from liansuo.stations.loader import load
 from liansuo.stations.plotfiles import NEED_MATPLOTLIB
 
 ROOT = Path(__file__).resolve().parent.parent
-SCENARIO = ROOT / "examples" / "scenarios" / "jiaopei-receive-depart.yaml"
+PKG = ROOT / "src" / "liansuo"
+SCENARIO = PKG / "examples" / "scenarios" / "jiaopei-receive-depart.yaml"
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 
 

@@ -14,6 +14,7 @@ from conftest import TWO_TESTS_SCRIPT
 pytest_plugins = ["pytester"]
 
 ROOT = Path(__file__).parent.parent
+PKG = ROOT / "src" / "liansuo"
 # the inner runs need neither the cache nor the Textual snapshot plugin (whose session hook expects its own run)
 QUIET = ("-p", "no:cacheprovider", "-p", "no:textual-snapshot")
 
@@ -21,7 +22,7 @@ QUIET = ("-p", "no:cacheprovider", "-p", "no:textual-snapshot")
 
 def test_scripts_are_collected_and_failures_show_step_expectation_and_state(pytester: pytest.Pytester) -> None:
     pytester.makefile(".yaml", test_routes=TWO_TESTS_SCRIPT)
-    station = (ROOT / "stations/library/jiaopei.yaml").read_text("utf-8")
+    station = (PKG / "stations/library/jiaopei.yaml").read_text("utf-8")
     (pytester.path / "test_jiaopei.yaml").write_text(station, encoding="utf-8")  # a station file: not a script
     (pytester.path / "other.yaml").write_text(TWO_TESTS_SCRIPT, encoding="utf-8")  # no pattern: not collected
     result = pytester.runpytest(*QUIET, "--junitxml=report.xml")
@@ -56,7 +57,7 @@ def test_malformed_script_is_a_collection_error_with_file_and_line(pytester: pyt
 
 
 def test_the_example_scripts_run_under_pytest(pytester: pytest.Pytester) -> None:
-    scripts = sorted(str(p) for p in (ROOT / "examples" / "scripts").glob("*.yaml"))
+    scripts = sorted(str(p) for p in (PKG / "examples" / "scripts").glob("*.yaml"))
     result = pytester.runpytest(*QUIET, *scripts)
     outcomes = result.parseoutcomes()
     assert outcomes.get("passed", 0) > 20 and "failed" not in outcomes
@@ -83,7 +84,7 @@ def test_importing_the_plugin_imports_no_layer_and_no_heavy_dependency() -> None
 
 
 def test_a_pytest_run_without_scripts_loads_the_plugin_and_nothing_heavy(pytester: pytest.Pytester) -> None:
-    station = (ROOT / "stations/library/jiaopei.yaml").read_text("utf-8")
+    station = (PKG / "stations/library/jiaopei.yaml").read_text("utf-8")
     (pytester.path / "test_jiaopei.yaml").write_text(station, encoding="utf-8")  # matches the patterns, not a script
     pytester.makepyfile(test_plain=f"import sys\n\ndef test_plain():\n    print('LOADED', *{LOADED})\n")
     # a fresh interpreter, so that this suite's own imports do not count; pytest-textual-snapshot imports textual

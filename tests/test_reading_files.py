@@ -20,8 +20,9 @@ from liansuo.stations.loader import load
 from liansuo.stations.source import StationError
 
 ROOT = Path(__file__).resolve().parent.parent
-MINIMAL = (ROOT / "examples" / "stations" / "minimal.yaml").read_text(encoding="utf-8")
-DANXIAN = (ROOT / "examples" / "stations" / "danxian.yaml").read_text(encoding="utf-8")
+PKG = ROOT / "src" / "liansuo"
+MINIMAL = (PKG / "examples" / "stations" / "minimal.yaml").read_text(encoding="utf-8")
+DANXIAN = (PKG / "examples" / "stations" / "danxian.yaml").read_text(encoding="utf-8")
 RAW_CONTROL = re.compile(r"[\x00-\x08\x0b-\x1f\x7f-\x9f]")
 # 700 bytes that expand to 10^10 values: each list repeats the one above it ten times, nine deep
 BOMB = "\n".join(["lol0: &l0 [lol, lol, lol, lol, lol, lol, lol, lol, lol, lol]",
@@ -184,7 +185,7 @@ def test_a_64d_line_without_sections_is_refused_not_crashed_in_verify(
 def test_a_rule_file_goes_through_the_same_reader(tmp_path: Path) -> None:
     folder = tmp_path / "rules"
     folder.mkdir()
-    for f in (ROOT / "rules" / "china").glob("*.yaml"):
+    for f in (PKG / "rules" / "china").glob("*.yaml"):
         (folder / f.name).write_text(f.read_text(encoding="utf-8"), encoding="utf-8")
     (folder / "design.yaml").write_text(BOMB, encoding="utf-8")
     with pytest.raises(RuleError) as info:

@@ -13,13 +13,14 @@ from liansuo.rules import DEFAULT, FILES, RuleError, RuleSet, bundled, load_rule
 from liansuo.simulation.sim import Simulation
 
 ROOT = Path(__file__).resolve().parents[1]
+PKG = ROOT / "src" / "liansuo"
 
 
 @pytest.fixture
 def folder(tmp_path: Path) -> Path:
     """A copy of the Chinese rule set to change."""
     out = tmp_path / "mine"
-    shutil.copytree(ROOT / "rules" / "china", out)
+    shutil.copytree(PKG / "rules" / "china", out)
     return out
 
 
@@ -33,7 +34,7 @@ def test_the_bundled_rule_set_has_every_part() -> None:
     assert DEFAULT in bundled()
     rules = load_rules()
     assert rules is load_rules(DEFAULT) and rules.name == DEFAULT
-    assert sorted(p.stem for p in (ROOT / "rules" / DEFAULT).glob("*.yaml")) == sorted(FILES)
+    assert sorted(p.stem for p in (PKG / "rules" / DEFAULT).glob("*.yaml")) == sorted(FILES)
     assert rules.aspects.stop in rules.aspects.closed and rules.aspects.guide not in rules.aspects.train_proceed
     assert rules.lamps is rules.aspects.lamps  # the interlocking reads the aspect tables by their old names
     assert rules.driving.platform_dwell_s > 0 and rules.design.tuning_area_m > 0 and rules.equipment.machines

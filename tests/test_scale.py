@@ -208,7 +208,7 @@ def test_the_plan_sorts_every_pair_as_a_test_a_pair_does() -> None:
     """The plan finds enemies, conditional and compatible pairs with bit sets; here they are found a pair at a time,
     on stations with conditional enemies (depot, doubleslip), with a focus, and on tables whose conflicts are listed
     on one route only."""
-    for name in ("jiaopei", "depot", "gaotie", "examples/stations/doubleslip.yaml"):
+    for name in ("jiaopei", "depot", "gaotie", "src/liansuo/examples/stations/doubleslip.yaml"):
         built = build_table(load(name if "/" not in name else Path(__file__).parent.parent / name))
         for table in (built, _lopsided(built)):
             ids = list(table.routes)
@@ -303,7 +303,7 @@ def test_routes_with_disjoint_footprints_are_never_kept_apart_by_the_oracle() ->
 
     rules = load_rules()
     stations = [load(name, rules=rules) for name in ("jiaopei", "gaotie", "depot")]
-    examples = Path(__file__).resolve().parents[1] / "examples" / "stations"
+    examples = Path(__file__).resolve().parents[1] / "src" / "liansuo" / "examples" / "stations"
     stations += [load(str(p), rules=rules) for p in sorted(examples.glob("*.yaml"))]
     stations.append(load_text(generate_hub(20, 8), "<hub20>"))
     skipped = 0

@@ -12,7 +12,7 @@ import pytest
 from liansuo.cli.main import main
 from liansuo.proving.scenario import parse_scenario, run_scenario
 
-SCENARIOS = sorted((Path(__file__).parent.parent / "examples" / "scenarios").glob("*.yaml"))
+SCENARIOS = sorted((Path(__file__).parent.parent / "src" / "liansuo" / "examples" / "scenarios").glob("*.yaml"))
 
 
 @pytest.mark.parametrize("path", SCENARIOS, ids=lambda p: p.stem)

@@ -20,11 +20,12 @@ from liansuo.simulation.exercise import parse_exercise
 from liansuo.stations.source import StationError
 
 ROOT = Path(__file__).resolve().parent.parent
+PKG = ROOT / "src" / "liansuo"
 MODELINE = re.compile(r"^# yaml-language-server: \$schema=(\S+)$")
 # every folder of bundled YAML files of a kind that has a schema, and that kind
-BUNDLED = {"stations/library": "station", "examples/stations": "station", "examples/broken": "station",
-           "examples/scripts": "script", "tests/scripts": "script", "examples/scenarios": "scenario",
-           "liansuo/exercises": "exercise"}
+BUNDLED = {"src/liansuo/stations/library": "station", "src/liansuo/examples/stations": "station",
+           "src/liansuo/examples/broken": "station", "src/liansuo/examples/scripts": "script",
+           "tests/scripts": "script", "src/liansuo/examples/scenarios": "scenario", "src/liansuo/exercises": "exercise"}
 BUNDLED_FILES = sorted((ROOT / folder / f.name, kind) for folder, kind in BUNDLED.items()
                        for f in (ROOT / folder).glob("*.yaml"))
 
@@ -79,7 +80,7 @@ def test_every_bundled_yaml_file_is_of_a_kind_with_a_schema() -> None:
     ZPW-2000A adjustment table, circuits/zpwadjust.py; the capacitor-fault article's tables,
     circuits/zpwvalidate.py)."""
     skipped = {".venv", ".git", "build", "dist", "rules"}
-    model_data = {ROOT / "circuits" / "zpwadjust.yaml", ROOT / "circuits" / "zpwvalidate.yaml"}
+    model_data = {PKG / "circuits" / "zpwadjust.yaml", PKG / "circuits" / "zpwvalidate.yaml"}
     found = {p for p in ROOT.rglob("*.yaml") if not skipped & set(p.relative_to(ROOT).parts)} - model_data
     assert found == {path for path, _ in BUNDLED_FILES}
     assert {kind for _, kind in BUNDLED_FILES} == set(KINDS)

@@ -9,7 +9,7 @@ import pytest
 
 from liansuo.cli.main import main
 
-EXAMPLES = sorted((Path(__file__).parent.parent / "examples" / "scripts").glob("*.yaml"))
+EXAMPLES = sorted((Path(__file__).parent.parent / "src" / "liansuo" / "examples" / "scripts").glob("*.yaml"))
 
 
 @pytest.mark.parametrize("script", EXAMPLES, ids=lambda p: p.stem)

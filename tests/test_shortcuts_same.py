@@ -41,8 +41,8 @@ from liansuo.stations.hubgen import generate_hub
 from liansuo.stations.loader import load_text
 from liansuo.stations.schema import EndKind
 
-EXAMPLES = sorted((Path(__file__).parent.parent / "examples" / "scripts").glob("*.yaml"))
-EXAMPLE_STATIONS = Path(__file__).parent.parent / "examples" / "stations"
+EXAMPLES = sorted((Path(__file__).parent.parent / "src" / "liansuo" / "examples" / "scripts").glob("*.yaml"))
+EXAMPLE_STATIONS = Path(__file__).parent.parent / "src" / "liansuo" / "examples" / "stations"
 
 
 def _hub_with_trains(cycles: int) -> Simulation:

@@ -27,7 +27,7 @@ from liansuo.stations.loader import load_text
 from liansuo.stations.schema import CircuitType, Direction
 
 Shunts = dict[str, list[tuple[float, float]]]
-DANXIAN = Path(__file__).resolve().parent.parent / "examples" / "stations" / "danxian.yaml"
+DANXIAN = Path(__file__).resolve().parent.parent / "src" / "liansuo" / "examples" / "stations" / "danxian.yaml"
 
 
 class Uncached:

@@ -165,7 +165,8 @@ def test_a_table_that_cannot_be_written_says_so_and_leaves_no_file(tmp_path: Pat
 def test_a_route_signal_gives_a_transfer_group_between_receiving_and_departure() -> None:
     """A route signal (进路信号机) inside the station splits the movement: X receives up to it, and the route from it
     onto the track is a transfer (转线), grouped after the departures of its direction and named by its tracks."""
-    text = (Path(__file__).resolve().parent.parent / "examples" / "stations" / "minimal.yaml").read_text("utf-8")
+    minimal = Path(__file__).resolve().parent.parent / "src" / "liansuo" / "examples" / "stations" / "minimal.yaml"
+    text = minimal.read_text("utf-8")
     text = text.replace("  - {id: XI, kind: starting", "  - {id: XL1, kind: route, at: J-1I, direction: down, "
                         "lamps: [U, L, H], buttons: [train]}\n  - {id: XI, kind: starting", 1)
     signed = signed_table(build_table(load_text(text, "m.yaml")))

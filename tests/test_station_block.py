@@ -17,7 +17,7 @@ from liansuo.simulation.sim import Simulation
 from liansuo.stations.loader import load, load_text
 from liansuo.stations.source import StationError
 
-DANXIAN = Path(__file__).resolve().parent.parent / "examples" / "stations" / "danxian.yaml"
+DANXIAN = Path(__file__).resolve().parent.parent / "src" / "liansuo" / "examples" / "stations" / "danxian.yaml"
 
 
 @pytest.fixture

@@ -25,9 +25,10 @@ from liansuo.stations.schema import StationFile
 from liansuo.stations.source import read_yaml
 
 ROOT = Path(__file__).resolve().parent.parent
-JIAOPEI = (ROOT / "stations" / "library" / "jiaopei.yaml").read_text(encoding="utf-8")
-SHUANGXIAN = (ROOT / "examples" / "stations" / "shuangxian.yaml").read_text(encoding="utf-8")
-MINIMAL = (ROOT / "examples" / "stations" / "minimal.yaml").read_text(encoding="utf-8")
+PKG = ROOT / "src" / "liansuo"
+JIAOPEI = (PKG / "stations" / "library" / "jiaopei.yaml").read_text(encoding="utf-8")
+SHUANGXIAN = (PKG / "examples" / "stations" / "shuangxian.yaml").read_text(encoding="utf-8")
+MINIMAL = (PKG / "examples" / "stations" / "minimal.yaml").read_text(encoding="utf-8")
 SB = "  - {id: SB, kind: boundary, at: 1500}"
 IG_TRACK = "  - {id: t-IG, from: J-1I, to: J-XI, section: IG, row: 0}"
 IG_SECTION = "  - {id: IG, type: zpw2000a, role: station_track, carrier: 1700-1, capacitors: {rule: standard}}"

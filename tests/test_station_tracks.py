@@ -13,7 +13,8 @@ from liansuo.interlocking.table import build_table
 from liansuo.stations.loader import load
 
 ROOT = Path(__file__).resolve().parent.parent
-BROKEN = ROOT / "examples" / "broken" / "no-starting-signal.yaml"
+PKG = ROOT / "src" / "liansuo"
+BROKEN = PKG / "examples" / "broken" / "no-starting-signal.yaml"
 
 
 def test_a_home_signal_gets_no_route_through_a_track_without_its_starting_signal() -> None:
@@ -37,6 +38,6 @@ def test_check_and_table_print_the_warning(capsys: pytest.CaptureFixture[str]) -
 
 
 def test_the_bundled_and_example_stations_lose_no_route() -> None:
-    examples = sorted((ROOT / "examples" / "stations").glob("*.yaml"))
+    examples = sorted((PKG / "examples" / "stations").glob("*.yaml"))
     for name in ("jiaopei", "gaotie", "depot", *(str(p) for p in examples)):
         assert build_table(load(name)).warnings == [], name

@@ -25,11 +25,12 @@ from liansuo.stations.source import Diagnostic, StationError
 from liansuo.stations.station import Station
 
 ROOT = Path(__file__).resolve().parent.parent
-MINIMAL = ROOT / "examples" / "stations" / "minimal.yaml"
+PKG = ROOT / "src" / "liansuo"
+MINIMAL = PKG / "examples" / "stations" / "minimal.yaml"
 DOC = ROOT / "docs" / "station-format.md"
 GLOSSARY = ROOT / "docs" / "glossary.md"
 BASE = MINIMAL.read_text(encoding="utf-8")
-JIAOPEI = (ROOT / "stations" / "library" / "jiaopei.yaml").read_text(encoding="utf-8")
+JIAOPEI = (PKG / "stations" / "library" / "jiaopei.yaml").read_text(encoding="utf-8")
 
 
 # ---- helpers (edit, position: conftest.py) ------------------------------------------------------------------
@@ -574,7 +575,7 @@ def test_format_doc_explains_every_key() -> None:
 
 def test_format_doc_lists_every_design_rule_and_enum_value() -> None:
     doc = DOC.read_text(encoding="utf-8")
-    rules = ROOT / "rules" / "china" / "design.yaml"
+    rules = PKG / "rules" / "china" / "design.yaml"
     for key, value in yaml.safe_load(rules.read_text(encoding="utf-8")).items():
         assert f"`{key}`" in doc, key
         for number, figure in (value.items() if isinstance(value, dict) else [("", value)]):

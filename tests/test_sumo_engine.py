@@ -26,6 +26,7 @@ from liansuo.simulation.trains.sumo_export import (
 from liansuo.stations.loader import load
 
 ROOT = Path(__file__).resolve().parent.parent
+PKG = ROOT / "src" / "liansuo"
 SUMO_MISSING = sumo_installed()
 needs_sumo = pytest.mark.skipif(bool(SUMO_MISSING), reason=f"needs the sumo extra: {SUMO_MISSING}")
 
@@ -133,14 +134,14 @@ def test_without_the_extra_the_sumo_engine_says_how_to_install_it(monkeypatch: p
     monkeypatch.setattr(sumo_module, "sumo_installed", lambda: "libsumo not installed (pip install 'liansuo[sumo]')")
     with pytest.raises(SumoUnavailable, match=r"liansuo\[sumo\]"):
         Simulation("jiaopei", engine="sumo")
-    scenario = ROOT / "examples" / "scenarios" / "jiaopei-receive-depart.yaml"
+    scenario = PKG / "examples" / "scenarios" / "jiaopei-receive-depart.yaml"
     assert cli_main(["run", str(scenario), "--engine", "sumo"]) == 2
     assert "liansuo[sumo]" in capsys.readouterr().err
 
 
 @needs_sumo
 def test_cli_runs_a_scenario_on_sumo(capsys: pytest.CaptureFixture[str]) -> None:
-    scenario = ROOT / "examples" / "scenarios" / "jiaopei-receive-depart.yaml"
+    scenario = PKG / "examples" / "scenarios" / "jiaopei-receive-depart.yaml"
     assert cli_main(["run", str(scenario), "--engine", "sumo"]) == 0
     out = capsys.readouterr().out
     assert "train T1 has left the station" in out and "engine failed" not in out

@@ -13,8 +13,9 @@ import pytest
 from liansuo.stations.fit import fit, metres, plural
 
 ROOT = Path(__file__).resolve().parent.parent
-EXAMPLES = sorted(str(p.relative_to(ROOT)) for p in (ROOT / "examples" / "stations").glob("*.yaml"))
-STATIONS = ["jiaopei", "gaotie", "depot", *EXAMPLES, "examples/broken/gaotie-no-diamond-protection.yaml"]
+PKG = ROOT / "src" / "liansuo"
+EXAMPLES = sorted(str(p.relative_to(ROOT)) for p in (PKG / "examples" / "stations").glob("*.yaml"))
+STATIONS = ["jiaopei", "gaotie", "depot", *EXAMPLES, "src/liansuo/examples/broken/gaotie-no-diamond-protection.yaml"]
 
 
 def width(line: str) -> int:
@@ -40,11 +41,11 @@ def test_check_fits_100_columns(station: str) -> None:
 
 
 @pytest.mark.parametrize("args", [("stations",), ("zpw", "gaotie"), ("25hz", "jiaopei", "--section", "IG"),
-                                  ("verify", "examples/stations/minimal.yaml"),
+                                  ("verify", "src/liansuo/examples/stations/minimal.yaml"),
                                   ("soak", "jiaopei", "--steps", "150"),
-                                  ("run", "examples/scenarios/jiaopei-receive-depart.yaml"),
-                                  ("test", "examples/scripts/jiaopei-interlocking-test.yaml"),
-                                  ("test", "-v", "examples/scripts/dead-zone-hazard.yaml")])
+                                  ("run", "src/liansuo/examples/scenarios/jiaopei-receive-depart.yaml"),
+                                  ("test", "src/liansuo/examples/scripts/jiaopei-interlocking-test.yaml"),
+                                  ("test", "-v", "src/liansuo/examples/scripts/dead-zone-hazard.yaml")])
 def test_text_commands_fit_100_columns(args: tuple[str, ...]) -> None:
     out = liansuo(*args)
     assert out.strip()
@@ -57,7 +58,7 @@ def test_the_table_fits_120_columns() -> None:
 
 
 def test_verify_counts_in_words() -> None:
-    last = liansuo("verify", "examples/stations/minimal.yaml").strip().splitlines()[-1]
+    last = liansuo("verify", "src/liansuo/examples/stations/minimal.yaml").strip().splitlines()[-1]
     assert "(2 routes, 1 pair)" in last and "0 failures" in last and "1 pairs" not in last
 
 

@@ -15,7 +15,8 @@ from liansuo.simulation.sim import Simulation
 from liansuo.simulation.trains.sumo import sumo_installed
 
 ROOT = Path(__file__).resolve().parent.parent
-SCENARIOS = sorted((ROOT / "examples" / "scenarios").glob("*.yaml"))
+PKG = ROOT / "src" / "liansuo"
+SCENARIOS = sorted((PKG / "examples" / "scenarios").glob("*.yaml"))
 SUMO_MISSING = sumo_installed()
 
 

@@ -17,7 +17,7 @@ from liansuo.tui.layout import Ref
 from liansuo.tui.paint import BAND_COLOUR, LAMP_COLOUR, glyph
 from liansuo.tui.panels import FunctionBar
 
-EXERCISES = Path(__file__).resolve().parent.parent / "liansuo" / "exercises"
+EXERCISES = Path(__file__).resolve().parent.parent / "src" / "liansuo" / "exercises"
 async def click(pilot: Any, ref: Ref) -> None:
     await pilot.pause()  # the diagram centres itself after its first refresh (when the station is wider than it)
     diagram = pilot.app.diagram

@@ -17,8 +17,9 @@ from liansuo.stations.library import bundled
 from liansuo.stations.loader import load
 
 ROOT = Path(__file__).parent.parent
-BROKEN = ROOT / "examples" / "broken" / "gaotie-no-diamond-protection.yaml"
-MINIMAL = (ROOT / "examples" / "stations" / "minimal.yaml").read_text(encoding="utf-8")
+PKG = ROOT / "src" / "liansuo"
+BROKEN = PKG / "examples" / "broken" / "gaotie-no-diamond-protection.yaml"
+MINIMAL = (PKG / "examples" / "stations" / "minimal.yaml").read_text(encoding="utf-8")
 
 
 @pytest.mark.parametrize("name", sorted(bundled()))

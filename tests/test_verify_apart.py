@@ -28,7 +28,8 @@ from liansuo.rules import load_rules
 from liansuo.stations.station import Station
 
 ROOT = Path(__file__).parent.parent
-STATIONS = ["jiaopei", "gaotie", "depot", *(str(ROOT / "examples" / "stations" / f"{s}.yaml")
+PKG = ROOT / "src" / "liansuo"
+STATIONS = ["jiaopei", "gaotie", "depot", *(str(PKG / "examples" / "stations" / f"{s}.yaml")
                                             for s in ("danxian", "shuangxian", "doubleslip")), "hub:10:4"]
 _NOT_ELEMENTS = {"id", "kind", "category", "direction", "aspects", "conflicts", "conflict_reasons",
                  "conditional_conflicts", "opposing", "position", "role", "release_s", "alternative", "length_m"}
@@ -131,7 +132,7 @@ def test_near_routes_without_the_oracles_footprints_are_caught_on_a_table_missin
     was = verify_module.near_routes
     monkeypatch.setattr(verify_module, "near_routes", lambda st, order, prints, focus: was(
         st, order, [frozenset()] * len(prints), focus))
-    danxian = load_station(str(ROOT / "examples" / "stations" / "danxian.yaml"))
+    danxian = load_station(str(PKG / "examples" / "stations" / "danxian.yaml"))
     assert unsimulated_sharing(danxian) == []  # the table is right: its rows say it all
     with next(m for m in MUTANTS if m.name == "no-overlap").applied():
         assert unsimulated_sharing(danxian)
@@ -139,7 +140,7 @@ def test_near_routes_without_the_oracles_footprints_are_caught_on_a_table_missin
         assert unsimulated_sharing(danxian) == []
 
 
-@pytest.mark.parametrize("name", ["jiaopei", str(ROOT / "examples" / "stations" / "shuangxian.yaml")])
+@pytest.mark.parametrize("name", ["jiaopei", str(PKG / "examples" / "stations" / "shuangxian.yaml")])
 def test_proving_pairs_apart_leaves_the_checks_and_the_verdict_as_simulating_them(name: str) -> None:
     fast = verify_station(name)
     full = verify_station(name, simulate_all=True)
