@@ -18,8 +18,8 @@ from pathlib import Path
 
 from browser import Browser
 
+from liansuo.classroom.passwords import hash_password
 from liansuo.server.client import ClassroomClient
-from liansuo.simulation.passwords import hash_password
 
 PASSWORD = "class of 2026"
 TEXTAREA = "textarea.xterm-helper-textarea"

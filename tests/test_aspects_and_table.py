@@ -12,11 +12,11 @@ from hypothesis import strategies as st
 
 from liansuo.cli.main import main
 from liansuo.interlocking.aspects import downgrade
-from liansuo.interlocking.table import build_table
+from liansuo.interlocking.table.build import build_table
+from liansuo.kit.source import StationError
 from liansuo.rules import load_rules
 from liansuo.stations.library import bundled
 from liansuo.stations.loader import load, load_text
-from liansuo.stations.source import StationError
 
 RULES = load_rules()
 ALL_LAMPS = ["L", "L2", "U", "U2", "H", "B", "A", "flasher"]

@@ -9,16 +9,16 @@ from pathlib import Path
 
 import pytest
 
+from liansuo.classroom.answers import Answer, parse_answers, play
+from liansuo.classroom.assessment import Assessment
+from liansuo.classroom.exercise import bundled_exercises, parse_exercise
+from liansuo.classroom.report import html_report, write_report
+from liansuo.classroom.roles import TRAINEE, refusal
+from liansuo.classroom.unsafe import fault_release_cause, guide_cause, planted, reach
 from liansuo.cli.main import main
-from liansuo.simulation.answers import Answer, parse_answers, play
-from liansuo.simulation.assessment import Assessment
-from liansuo.simulation.assessmentreport import html_report, write_report
-from liansuo.simulation.assessmentrules import fault_release_cause, guide_cause, planted, reach
-from liansuo.simulation.exercise import bundled_exercises, parse_exercise
-from liansuo.simulation.roles import TRAINEE, refusal
+from liansuo.kit.source import StationError
 from liansuo.simulation.sim import Simulation
 from liansuo.stations.loader import load
-from liansuo.stations.source import StationError
 
 ROOT = Path(__file__).resolve().parent.parent
 ANSWERS = ROOT / "tests" / "data" / "exercises"

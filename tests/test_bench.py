@@ -13,7 +13,7 @@ from liansuo.bench import report as bench
 from liansuo.bench.busy import busy_routes
 from liansuo.bench.report import Sizes, all_finite, as_text, run_bench
 from liansuo.cli.main import main
-from liansuo.interlocking.table import build_table
+from liansuo.interlocking.table.build import build_table
 from liansuo.simulation.sim import Simulation
 from liansuo.stations.hubgen import generate_hub
 from liansuo.stations.loader import load_text

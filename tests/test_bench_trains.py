@@ -8,7 +8,7 @@ from typing import Any
 import pytest
 
 from liansuo.bench.trains import run_trains, train_slots, trains_text
-from liansuo.interlocking.table import InterlockingTable, build_table
+from liansuo.interlocking.table.build import InterlockingTable, build_table
 from liansuo.simulation.trains.sumo import sumo_installed
 from liansuo.stations.hubgen import generate_hub
 from liansuo.stations.loader import load_text

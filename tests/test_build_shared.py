@@ -22,7 +22,7 @@ from liansuo.circuits.railgeometry import geometry_of
 from liansuo.circuits.trackcircuits import SectionCircuit, build_circuit
 from liansuo.interlocking.cbi import Interlocking
 from liansuo.interlocking.io import RelayBoard
-from liansuo.interlocking.table import build_table
+from liansuo.interlocking.table.build import build_table
 from liansuo.proving.oracle import Watch
 from liansuo.rules import RuleSet, load_rules
 from liansuo.simulation.sim import Simulation

@@ -14,7 +14,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from liansuo.circuits.phase25hz import (
+from liansuo.circuits.phase25.model import (
     Phase25HzCircuit,
     Phase25HzFaults,
     Phase25HzParams,

@@ -19,8 +19,8 @@ from pathlib import Path
 import pytest
 from browser import Browser, chromium
 
+from liansuo.classroom.passwords import hash_password
 from liansuo.server.client import ClassroomClient
-from liansuo.simulation.passwords import hash_password
 
 PASSWORD = "correct horse"
 TMUX = ["tmux", "-L", f"liansuo-e2e-{os.getpid()}"]

@@ -9,10 +9,10 @@ from pathlib import Path
 
 import pytest
 
+from liansuo.classroom.passwords import hash_password
+from liansuo.classroom.snapshot import EventCursor
 from liansuo.server.classroom import Classroom, SeatError
 from liansuo.server.websocket import ClassroomServer
-from liansuo.simulation.passwords import hash_password
-from liansuo.simulation.snapshot import EventCursor
 
 
 @pytest.fixture

@@ -13,9 +13,9 @@ from pathlib import Path
 import pytest
 from websockets.sync.client import connect
 
+from liansuo.classroom.passwords import hash_password, instructor_hash, matches
+from liansuo.classroom.snapshot import EventCursor
 from liansuo.server.client import ClassroomClient, ClassroomError
-from liansuo.simulation.passwords import hash_password, instructor_hash, matches
-from liansuo.simulation.snapshot import EventCursor
 
 PASSWORD = "correct horse"
 

@@ -11,9 +11,9 @@ from pathlib import Path
 import pytest
 
 from liansuo.cli.main import main
-from liansuo.simulation.recording import FileRecorder
+from liansuo.kit.jsonreport import SCHEMAS, version
+from liansuo.simulation.recording.recorder import FileRecorder
 from liansuo.simulation.sim import Simulation
-from liansuo.stations.jsonreport import SCHEMAS, version
 
 ROOT = Path(__file__).resolve().parent.parent
 PKG = ROOT / "src" / "liansuo"
@@ -216,7 +216,7 @@ def test_a_file_of_another_kind_is_named_as_such(tmp_path: Path, capsys: pytest.
 
 
 def test_every_bundled_and_example_file_is_its_own_kind() -> None:
-    from liansuo.stations.filekind import kind_of_file
+    from liansuo.kit.filekind import kind_of_file
 
     kinds = {"stations": "station", "scripts": "script", "scenarios": "scenario", "broken": "station"}
     for folder, kind in kinds.items():

@@ -8,7 +8,7 @@ from typing import Any
 import pytest
 
 from liansuo.circuits.faults import KINDS, PARAM_LIMITS
-from liansuo.simulation.recording import snapshot
+from liansuo.simulation.recording.recorder import snapshot
 from liansuo.simulation.sim import Simulation
 
 

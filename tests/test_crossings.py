@@ -8,10 +8,10 @@ from pathlib import Path
 import pytest
 from conftest import edit
 
-from liansuo.interlocking.table import build_table
+from liansuo.interlocking.table.build import build_table
+from liansuo.kit.source import StationError
 from liansuo.stations.library import resolve
 from liansuo.stations.loader import load_text
-from liansuo.stations.source import StationError
 
 ROOT = Path(__file__).resolve().parent.parent
 PKG = ROOT / "src" / "liansuo"

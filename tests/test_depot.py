@@ -7,7 +7,7 @@ import pytest
 from conftest import Driver
 
 from liansuo.cli.main import main
-from liansuo.interlocking.table import build_table
+from liansuo.interlocking.table.build import build_table
 from liansuo.simulation.sim import Simulation
 from liansuo.stations.loader import load
 from liansuo.stations.schema import EndKind, Lamp, SectionRole, SignalKind

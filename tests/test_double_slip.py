@@ -11,14 +11,14 @@ import pytest
 from conftest import Driver, edit, position
 
 from liansuo.cli.main import main
-from liansuo.interlocking.signedtable import Row, signed_table
-from liansuo.interlocking.table import InterlockingTable, build_table
+from liansuo.interlocking.table.build import InterlockingTable, build_table
+from liansuo.interlocking.table.signed import Row, signed_table
+from liansuo.kit.source import StationError
 from liansuo.proving.oracle import Watch
 from liansuo.proving.verify import verify_station
 from liansuo.rules import load_rules
 from liansuo.simulation.sim import Simulation
 from liansuo.stations.loader import load, load_text
-from liansuo.stations.source import StationError
 from liansuo.tui.layout import build_layout
 
 ROOT = Path(__file__).resolve().parent.parent

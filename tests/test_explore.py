@@ -15,7 +15,7 @@ from liansuo.proving.explore.actions import Bounds
 from liansuo.proving.explore.key import state_key
 from liansuo.proving.explore.report import script
 from liansuo.proving.explore.search import Expander, Trace, expand_here, search
-from liansuo.proving.mutants import MUTANTS
+from liansuo.proving.mutation.mutants import MUTANTS
 from liansuo.proving.scripts import parse_script, run_script
 from liansuo.rules import load_rules
 from liansuo.stations.loader import load

@@ -11,14 +11,14 @@ import jsonschema
 import pytest
 from conftest import Driver, edit
 
-from liansuo.interlocking.table import InterlockingTable, build_table
-from liansuo.interlocking.tableformat import as_json
-from liansuo.interlocking.tableschema import TABLE_SCHEMA
+from liansuo.interlocking.table.build import InterlockingTable, build_table
+from liansuo.interlocking.table.schema import TABLE_SCHEMA
+from liansuo.interlocking.table.text import as_json
+from liansuo.kit.source import StationError
 from liansuo.proving.verify import verify_station
 from liansuo.simulation.sim import Simulation
 from liansuo.stations.loader import load, load_text
 from liansuo.stations.rules import design_rules
-from liansuo.stations.source import StationError
 
 ROOT = Path(__file__).resolve().parent.parent
 PKG = ROOT / "src" / "liansuo"

@@ -1,4 +1,4 @@
-"""The command language under fuzzing (simulation/commandfuzz.py): random and mutated command lines on the bundled
+"""The command language under fuzzing (proving/fuzz/commands.py): random and mutated command lines on the bundled
 stations never raise, and a refused line changes nothing. Derandomized and small here; ``liansuo fuzz commands``
 runs the same generator longer (docs/robustness.md)."""
 
@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 from hypothesis import HealthCheck, given, settings
 
-from liansuo.simulation.commandfuzz import RefusalChangedState, Session, attempt, corpus, strategy
+from liansuo.proving.fuzz.commands import RefusalChangedState, Session, attempt, corpus, strategy
 
 SAMPLE_LIMIT_S = 10.0  # a sample runs its lines and a few cycles: seconds at most, even with a 'run 1h'
 

@@ -7,7 +7,7 @@ import time
 
 from hypothesis import HealthCheck, given, settings
 
-from liansuo.simulation import fuzzrecordings
+from liansuo.proving.fuzz import recordings as fuzzrecordings
 
 SAMPLE_LIMIT_S = 10.0  # far above what a sample takes (well under a second): only a hang reaches it
 

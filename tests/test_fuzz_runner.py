@@ -14,9 +14,9 @@ from typing import Any
 import pytest
 from hypothesis import strategies as st
 
-from liansuo.cli import fuzz as fuzzcli
 from liansuo.cli.main import main
-from liansuo.proving.fuzzing import run
+from liansuo.proving.fuzz import cli as fuzzcli
+from liansuo.proving.fuzz.runner import run
 
 
 def _kind(name: str, strategy: Any, attempt: Any) -> ModuleType:

@@ -9,8 +9,8 @@ from pathlib import Path
 import pytest
 from hypothesis import given, settings
 
-from liansuo.cli.fuzzstations import EXAMPLES, NAME, StationSample, attempt, run, strategy
 from liansuo.cli.main import main
+from liansuo.proving.fuzz.stations import EXAMPLES, NAME, StationSample, attempt, run, strategy
 
 SECONDS = 10  # per sample: check, table and verify of a small station take well under one
 
@@ -56,3 +56,16 @@ def test_check_refuses_an_added_enemy_naming_no_route_as_table_does(tmp_path: Pa
     for command in ("check", "table"):
         code, _, err = run(command, str(file))
         assert code == 3 and said in err, command
+
+
+@pytest.mark.parametrize("argv", [("check", "gaotie"), ("check", "jiaopei", "--format", "json"),
+                                  ("table", "jiaopei"), ("verify", str(EXAMPLES / "minimal.yaml"))])
+def test_the_fuzzers_commands_are_the_command_lines(argv: tuple[str, ...], capsys: pytest.CaptureFixture[str]) -> None:
+    """The fuzzer registers check, table and verify from their rooms as cli/main.py does: the same answers."""
+    code = main(list(argv))
+    out, err = capsys.readouterr()
+    fuzzed = run(*argv)
+    if argv[0] == "verify":  # its last line times the run
+        assert (fuzzed[0], fuzzed[1].splitlines()[:-1], fuzzed[2]) == (code, out.splitlines()[:-1], err)
+    else:
+        assert fuzzed == (code, out, err)

@@ -13,7 +13,7 @@ from unittest import mock
 import pytest
 
 from liansuo.interlocking import operations
-from liansuo.proving.mutants import MUTANTS
+from liansuo.proving.mutation.mutants import MUTANTS
 from liansuo.proving.oracle import Watch
 from liansuo.proving.oracle.watch import Violation
 from liansuo.simulation.sim import Simulation

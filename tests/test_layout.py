@@ -11,13 +11,15 @@ import networkx as nx
 
 ROOT = Path(__file__).resolve().parents[1]
 PKG = ROOT / "src" / "liansuo"
-LAYERS = ("rules", "stations", "circuits", "interlocking", "simulation", "proving", "bench", "tui", "server",
-          "remote", "cli")
+LAYERS = ("kit", "rules", "stations", "circuits", "interlocking", "simulation", "classroom", "proving", "bench", "tui",
+          "server", "remote", "cli")
 # the floor of each layer: a module imports only from its own layer or from a lower floor (README.md, "Layout")
-FLOOR = {"rules": 0, "stations": 1, "circuits": 2, "interlocking": 2, "simulation": 3, "proving": 4, "tui": 4,
-         "server": 4, "bench": 5, "remote": 5, "cli": 6}
-# bench measures what proving runs (verify, soak), so it stands above it; remote (the classroom's clients) puts the
-# console (tui) on the server's seats, so it stands above both
+FLOOR = {"kit": 0, "rules": 1, "stations": 2, "circuits": 3, "interlocking": 3, "simulation": 4, "classroom": 5,
+         "tui": 6, "server": 6, "proving": 7, "remote": 7, "bench": 8, "cli": 9}
+# the classroom (roles, exercises, assessment) stands on the simulation, below the console and the server that both
+# use it; proving stands above the console, whose fuzzer it holds; bench measures what proving runs (verify, soak),
+# so it stands above it; remote (the classroom's clients) puts the console (tui) on the server's seats, so it stands
+# above both
 
 
 def test_every_layer_is_a_folder_of_the_package_and_nothing_is_linked() -> None:

@@ -1,5 +1,5 @@
-"""The checks are strong: seeded defects of the interlocking (proving/mutants.py) are caught by ``liansuo verify`` or
-the safety oracle, at least 95 % of them, and the report says by which check."""
+"""The checks are strong: seeded defects of the interlocking (proving/mutation/mutants.py) are caught by
+``liansuo verify`` or the safety oracle, at least 95 % of them, and the report says by which check."""
 
 from __future__ import annotations
 
@@ -9,8 +9,8 @@ from pathlib import Path
 import pytest
 
 from liansuo.cli.main import main
-from liansuo.proving.mutants import MUTANTS
-from liansuo.proving.mutation import default_stations, first_where_it_shows, run_mutants
+from liansuo.proving.mutation.cli import default_stations, first_where_it_shows, run_mutants
+from liansuo.proving.mutation.mutants import MUTANTS
 
 
 def test_at_least_twenty_distinct_defects_and_95_percent_caught() -> None:
@@ -58,7 +58,7 @@ def test_a_mutant_refuses_a_compiled_interlocking_rather_than_go_untried(monkeyp
     """Under a native build (docs/native.md) a patch of a compiled module would change nothing: applying a mutant in
     a process where the interlocking runs compiled must say so, not run verify on the sound interlocking. The suite
     runs pure, so the compiled state is stood in for by what ``native_modules`` reports."""
-    import liansuo.proving.mutants as mutants
+    import liansuo.proving.mutation.mutants as mutants
 
     monkeypatch.setattr(mutants, "native_modules", lambda: ["liansuo.circuits.field", "liansuo.interlocking.core"])
     with pytest.raises(RuntimeError, match=r"interlocking runs compiled \(liansuo.interlocking.core\).*LIANSUO_PURE"), \

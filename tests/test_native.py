@@ -14,7 +14,6 @@ It takes about four minutes (two of them building), so it runs on demand: ``pyte
 
 from __future__ import annotations
 
-import ast
 import json
 import os
 import shutil
@@ -25,6 +24,8 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+
+from liansuo.kit.native import MODULES
 
 pytestmark = pytest.mark.native
 
@@ -39,7 +40,7 @@ TIMINGS = {"elapsed_s", "seconds"}
 TRAINS = """\
 import json
 from liansuo.bench.trains import measure_trains
-from liansuo.interlocking.table import build_table
+from liansuo.interlocking.table.build import build_table
 from liansuo.stations.hubgen import generate_hub
 from liansuo.stations.loader import load_text
 station = load_text(generate_hub(50, 20), "<hub50>")
@@ -57,12 +58,8 @@ print(json.dumps([liansuo.__file__, liansuo.native_modules()]))
 
 
 def native_list() -> list[str]:
-    """setup.py's NATIVE, read without running it."""
-    tree = ast.parse((ROOT / "setup.py").read_text(encoding="utf-8"))
-    for node in tree.body:
-        if isinstance(node, ast.Assign) and any(isinstance(t, ast.Name) and t.id == "NATIVE" for t in node.targets):
-            return [str(v) for v in ast.literal_eval(node.value)]
-    raise AssertionError("setup.py has no NATIVE list")
+    """The compiled modules (kit/native.py)."""
+    return list(MODULES)
 
 
 def _ignore(folder: str, names: list[str]) -> set[str]:

@@ -12,13 +12,13 @@ from pathlib import Path
 
 import pytest
 
-from liansuo.circuits.phase25hz import Phase25HzFaults
-from liansuo.circuits.phase25sweep import section_model
-from liansuo.circuits.zpw2000a import ZpwFaults
-from liansuo.circuits.zpwadjust import section_circuit  # as `liansuo zpw` adjusts it (the table)
+from liansuo.circuits.phase25.model import Phase25HzFaults
+from liansuo.circuits.phase25.sweep import section_model
+from liansuo.circuits.zpw.adjust import section_circuit  # as `liansuo zpw` adjusts it (the table)
+from liansuo.circuits.zpw.model import ZpwFaults
 from liansuo.cli.main import main
+from liansuo.kit.plotfiles import NEED_MATPLOTLIB
 from liansuo.stations.loader import load
-from liansuo.stations.plotfiles import NEED_MATPLOTLIB
 
 ROOT = Path(__file__).resolve().parent.parent
 PKG = ROOT / "src" / "liansuo"

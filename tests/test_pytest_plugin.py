@@ -65,7 +65,9 @@ def test_the_example_scripts_run_under_pytest(pytester: pytest.Pytester) -> None
 
 # What the plugin may bring into a pytest run that collects no script: the package root (lazy, tests/test_layout.py)
 # and the plugin itself. The layers, YAML and the heavy dependencies come only with a script.
-LIGHT = {"liansuo", "liansuo.proving", "liansuo.proving.pytest_plugin"}
+# the suite runs with LIANSUO_PURE=1 (conftest.py): the switch to the Python sources, kit/native.py (standard
+# library only), comes with the package then
+LIGHT = {"liansuo", "liansuo.proving", "liansuo.proving.pytest_plugin", "liansuo.kit", "liansuo.kit.native"}
 HEAVY = ("liansuo", "yaml", "numpy", "textual", "pydantic", "networkx")
 LOADED = f"sorted(m for m in sys.modules if m.startswith({HEAVY!r}))"
 

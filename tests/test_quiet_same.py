@@ -33,7 +33,7 @@ from liansuo.cli.main import main
 from liansuo.interlocking.cbi import Interlocking
 from liansuo.interlocking.io import Outputs
 from liansuo.interlocking.state import OpenMemo, Reads, ReleaseMemo, SettingMemo
-from liansuo.interlocking.table import build_table
+from liansuo.interlocking.table.build import build_table
 from liansuo.proving.verify import verify_station
 from liansuo.proving.verify.probe import Probe
 from liansuo.rules import RuleSet

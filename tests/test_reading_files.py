@@ -12,12 +12,12 @@ from pathlib import Path
 import pytest
 
 from liansuo.cli.main import main
+from liansuo.kit.inputlimits import LIMITS
+from liansuo.kit.source import StationError
 from liansuo.proving.pytest_plugin import is_script
 from liansuo.rules import RuleError, load_rules
-from liansuo.rules.inputlimits import LIMITS
 from liansuo.stations.library import describe
 from liansuo.stations.loader import load
-from liansuo.stations.source import StationError
 
 ROOT = Path(__file__).resolve().parent.parent
 PKG = ROOT / "src" / "liansuo"

@@ -7,12 +7,12 @@ from pathlib import Path
 
 import pytest
 
+from liansuo.classroom.exercise import bundled_exercises, check_goal, parse_exercise
 from liansuo.cli.main import main
+from liansuo.kit.source import StationError
 from liansuo.simulation import Simulation
-from liansuo.simulation.exercise import bundled_exercises, check_goal, parse_exercise
-from liansuo.simulation.recording import FileRecorder, Recorder, RecordingError, load_recording
-from liansuo.simulation.replayer import Replayer
-from liansuo.stations.source import StationError
+from liansuo.simulation.recording.recorder import FileRecorder, Recorder, RecordingError, load_recording
+from liansuo.simulation.recording.replayer import Replayer
 
 
 def record_session(path: Path) -> Simulation:

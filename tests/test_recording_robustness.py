@@ -12,9 +12,10 @@ from pathlib import Path
 import pytest
 
 from liansuo.cli.main import main
-from liansuo.simulation import Simulation, recordingfile
-from liansuo.simulation.recording import FileRecorder
-from liansuo.simulation.recordingschema import MAX_ERRORS
+from liansuo.simulation import Simulation
+from liansuo.simulation.recording import file as recordingfile
+from liansuo.simulation.recording.recorder import FileRecorder
+from liansuo.simulation.recording.schema import MAX_ERRORS
 from liansuo.stations.library import bundled
 
 STEPS = ("route X XI", "run 2s", "occupy IAG", "run 5s", "release X", "route S SI", "fault no-indication 5",

@@ -116,7 +116,7 @@ def test_overlap_locked_with_route_and_released_180s_after_train_on_the_receivin
 
 
 def test_overlap_is_part_of_the_table_and_conflicts_only_with_movements_that_do_not_continue_it() -> None:
-    from liansuo.interlocking.table import build_table
+    from liansuo.interlocking.table.build import build_table
 
     text = bundled()["jiaopei"].read_text(encoding="utf-8") + OVERLAP
     table = build_table(load_text(text, "jiaopei-overlap.yaml"))
@@ -142,7 +142,7 @@ def test_a_shunting_signal_held_for_its_passing_consist_still_sees_an_occupancy_
 
 
 def test_an_overlap_without_release_s_releases_after_the_rule_sets_overlap_release_s() -> None:
-    from liansuo.interlocking.table import build_table
+    from liansuo.interlocking.table.build import build_table
     from liansuo.rules import load_rules
 
     text = bundled()["jiaopei"].read_text(encoding="utf-8") + OVERLAP.replace(", release_s: 180", "")

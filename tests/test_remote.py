@@ -14,6 +14,7 @@ from typing import Any
 import pytest
 from consoletest import SIZE, message, run
 
+from liansuo.classroom.passwords import hash_password
 from liansuo.remote.app import RemoteConsoleApp
 from liansuo.remote.dashboard import DashboardScreen
 from liansuo.remote.link import Link
@@ -21,7 +22,6 @@ from liansuo.remote.sim import LOST
 from liansuo.server.classroom import Classroom
 from liansuo.server.client import ClassroomClient
 from liansuo.server.websocket import ClassroomServer
-from liansuo.simulation.passwords import hash_password
 from liansuo.tui.layout import Ref
 from liansuo.tui.paint import BAND_COLOUR, glyph
 

@@ -17,10 +17,10 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from liansuo.interlocking.table import InterlockingTable, Route, build_table
-from liansuo.interlocking.tableformat import as_json
+from liansuo.interlocking.table.build import InterlockingTable, Route, build_table
+from liansuo.interlocking.table.text import as_json
 from liansuo.proving.progress import progress
-from liansuo.proving.soakcli import soak_runs
+from liansuo.proving.soak.cli import soak_runs
 from liansuo.proving.spread import client
 from liansuo.proving.verify import verify_station
 from liansuo.proving.verify.plan import CHAIN, Batch, by_turnouts, cover, plan
@@ -321,7 +321,7 @@ def test_routes_with_disjoint_footprints_are_never_kept_apart_by_the_oracle() ->
 def test_an_item_that_fails_on_the_shared_simulation_is_reported_with_its_own_script() -> None:
     """A route's section items run in turn on one simulation; a failing one is run again alone, so its script holds
     that one section only, as when every item had a fresh simulation."""
-    from liansuo.proving.mutants import MUTANTS
+    from liansuo.proving.mutation.mutants import MUTANTS
 
     mutant = next(m for m in MUTANTS if m.name == "blind-to-occupancy")
     with mutant.applied():

@@ -12,12 +12,12 @@ import pytest
 import yaml
 from jsonschema import Draft202012Validator
 
+from liansuo.classroom.exercise import parse_exercise
 from liansuo.cli.main import main
 from liansuo.cli.schemas import KINDS, file_name, generate, shipped
+from liansuo.kit.source import StationError
 from liansuo.proving.scenario import parse_scenario
 from liansuo.proving.scripts import parse_script
-from liansuo.simulation.exercise import parse_exercise
-from liansuo.stations.source import StationError
 
 ROOT = Path(__file__).resolve().parent.parent
 PKG = ROOT / "src" / "liansuo"
@@ -77,10 +77,10 @@ def test_schema_of_an_unknown_kind_is_a_usage_error(capsys: pytest.CaptureFixtur
 def test_every_bundled_yaml_file_is_of_a_kind_with_a_schema() -> None:
     """A new folder of YAML files must be added to BUNDLED (and its files given a modeline); the rule sets have
     models of their own (rules/), not a schema for editors; so has the model data the code writes and reads (the
-    ZPW-2000A adjustment table, circuits/zpwadjust.py; the capacitor-fault article's tables,
-    circuits/zpwvalidate.py)."""
+    ZPW-2000A adjustment table, circuits/zpw/adjust.py; the capacitor-fault article's tables,
+    circuits/zpw/validate.py)."""
     skipped = {".venv", ".git", "build", "dist", "rules"}
-    model_data = {PKG / "circuits" / "zpwadjust.yaml", PKG / "circuits" / "zpwvalidate.yaml"}
+    model_data = {PKG / "circuits" / "zpw" / "adjust.yaml", PKG / "circuits" / "zpw" / "validate.yaml"}
     found = {p for p in ROOT.rglob("*.yaml") if not skipped & set(p.relative_to(ROOT).parts)} - model_data
     assert found == {path for path, _ in BUNDLED_FILES}
     assert {kind for _, kind in BUNDLED_FILES} == set(KINDS)

@@ -29,7 +29,7 @@ from liansuo.cli.main import main
 from liansuo.interlocking.cbi import Interlocking
 from liansuo.interlocking.lifecycle import RouteLifecycle
 from liansuo.interlocking.state import RouteState
-from liansuo.interlocking.table import build_table
+from liansuo.interlocking.table.build import build_table
 from liansuo.proving.verify import verify_station
 from liansuo.simulation.sim import Simulation
 from liansuo.simulation.trains import fleet as fleet_module

@@ -16,7 +16,7 @@ from conftest import Driver
 from liansuo.bench.trains import _Dispatcher, train_slots
 from liansuo.circuits.shunts import Listed
 from liansuo.circuits.trackcircuits import SectionCircuit, build_circuit
-from liansuo.interlocking.table import build_table
+from liansuo.interlocking.table.build import build_table
 from liansuo.simulation.sim import Simulation
 from liansuo.simulation.trains.consist import Consist
 from liansuo.simulation.trains.fleet import WHEEL_OHM

@@ -14,10 +14,10 @@ import pytest
 from openpyxl import load_workbook
 
 from liansuo.cli.main import main
-from liansuo.interlocking.signedtable import Row, signed_table
-from liansuo.interlocking.table import build_table
-from liansuo.interlocking.tableformat import as_csv, as_json, as_text
-from liansuo.interlocking.tableschema import TABLE_SCHEMA
+from liansuo.interlocking.table.build import build_table
+from liansuo.interlocking.table.schema import TABLE_SCHEMA
+from liansuo.interlocking.table.signed import Row, signed_table
+from liansuo.interlocking.table.text import as_csv, as_json, as_text
 from liansuo.stations.loader import load, load_text
 
 

@@ -1,13 +1,13 @@
-"""What a snapshot (simulation/snapshot.py) carries beyond the state of the elements, for a console drawing a seat of
+"""What a snapshot (classroom/snapshot.py) carries beyond the state of the elements, for a console drawing a seat of
 the classroom server: the sealed buttons' counters, why a red signal waits, and the faults, for the instructor only."""
 
 from __future__ import annotations
 
 import json
 
-from liansuo.simulation.roles import INSTRUCTOR, TRAINEE
+from liansuo.classroom.roles import INSTRUCTOR, TRAINEE
+from liansuo.classroom.snapshot import EventCursor, SnapshotView, snapshot
 from liansuo.simulation.sim import Simulation
-from liansuo.simulation.snapshot import EventCursor, SnapshotView, snapshot
 
 
 def test_a_snapshot_says_why_a_signal_waits_and_counts_the_sealed_buttons() -> None:

@@ -12,7 +12,7 @@ import yaml
 from liansuo.cli.main import main
 from liansuo.interlocking.lifecycle import RouteLifecycle
 from liansuo.interlocking.state import RouteStage, RouteState
-from liansuo.proving.soak import soak
+from liansuo.proving.soak.run import soak
 
 
 def test_soak_reports_steps_and_no_violations(capsys: pytest.CaptureFixture[str]) -> None:

@@ -9,13 +9,13 @@ import pytest
 from conftest import Driver
 
 from liansuo.cli.main import main
-from liansuo.interlocking.table import build_table
-from liansuo.proving.mutants import MUTANTS
-from liansuo.proving.mutation import run_mutants
+from liansuo.interlocking.table.build import build_table
+from liansuo.kit.source import StationError
+from liansuo.proving.mutation.cli import run_mutants
+from liansuo.proving.mutation.mutants import MUTANTS
 from liansuo.proving.verify import verify_station
 from liansuo.simulation.sim import Simulation
 from liansuo.stations.loader import load, load_text
-from liansuo.stations.source import StationError
 
 DANXIAN = Path(__file__).resolve().parent.parent / "src" / "liansuo" / "examples" / "stations" / "danxian.yaml"
 

@@ -9,9 +9,11 @@ from pathlib import Path
 import pytest
 from conftest import edit, position
 
-from liansuo.circuits.zpwadjust import section_circuit
+from liansuo.circuits.zpw.adjust import section_circuit
 from liansuo.cli.main import main
 from liansuo.interlocking.autoblock import AutoBlock
+from liansuo.kit.exitcodes import Exit
+from liansuo.kit.source import read_yaml
 from liansuo.proving.verify import station as verify_station_items
 from liansuo.proving.verify import verify_station
 from liansuo.proving.verify.units import Bench
@@ -19,10 +21,8 @@ from liansuo.rules import load_rules
 from liansuo.simulation.sim import Simulation
 from liansuo.stations import limits
 from liansuo.stations.checks import cross_check
-from liansuo.stations.exitcodes import Exit
 from liansuo.stations.loader import load, load_text
 from liansuo.stations.schema import StationFile
-from liansuo.stations.source import read_yaml
 
 ROOT = Path(__file__).resolve().parent.parent
 PKG = ROOT / "src" / "liansuo"

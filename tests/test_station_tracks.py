@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 from liansuo.cli.main import main
-from liansuo.interlocking.table import build_table
+from liansuo.interlocking.table.build import build_table
 from liansuo.stations.loader import load
 
 ROOT = Path(__file__).resolve().parent.parent

@@ -17,11 +17,11 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from pydantic import BaseModel
 
+from liansuo.kit.source import Diagnostic, StationError
 from liansuo.stations import schema
 from liansuo.stations.library import bundled
 from liansuo.stations.loader import load, load_text
 from liansuo.stations.rules import design_rules, min_coded_length
-from liansuo.stations.source import Diagnostic, StationError
 from liansuo.stations.station import Station
 
 ROOT = Path(__file__).resolve().parent.parent

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from liansuo.stations.fit import fit, metres, plural
+from liansuo.kit.fit import fit, metres, plural
 
 ROOT = Path(__file__).resolve().parent.parent
 PKG = ROOT / "src" / "liansuo"

@@ -343,7 +343,7 @@ async def test_recording_and_replay_reproduce_the_session(tmp_path: Path) -> Non
     assert [(r["line"], r["by"]) for r in records if r["k"] == "cmd"] == [
         ("route X XI", "trainee"), ("fault broken-rail IG", "instructor"), ("route S SI", "trainee")]
 
-    from liansuo.simulation.recording import load_recording
+    from liansuo.simulation.recording.recorder import load_recording
     from liansuo.tui.replay import ReplayApp
 
     rec = load_recording(path)

@@ -1,6 +1,6 @@
 """Fuzzing the console (issue 17, item 5): random operator sessions, derandomized and short, through Textual's pilot
-(``tui/fuzz.py``; ``liansuo fuzz console --budget N`` runs the same generator longer). Each sample is a bundled
-station, a window and a few dozen keys, typed and pasted commands, clicks, bursts of clicks, palette and dialog
+(``proving/fuzz/console.py``; ``liansuo fuzz console --budget N`` runs the same generator longer). Each sample is a
+bundled station, a window and a few dozen keys, typed and pasted commands, clicks, bursts of clicks, palette and dialog
 sequences, resizes down to 1x1 and waits; the console must survive every one, with no error even caught and shown."""
 
 from __future__ import annotations
@@ -9,7 +9,7 @@ import time
 
 from hypothesis import HealthCheck, Phase, given, settings
 
-from liansuo.tui import fuzz
+from liansuo.proving.fuzz import console as fuzz
 
 SAMPLE_LIMIT_S = 15.0  # a sample is a few seconds at most even on a slow, shared machine: far more is a hang
 

@@ -231,8 +231,8 @@ async def test_run_1h_advances_in_slices_shows_its_progress_and_esc_stops_it(mon
 
 @run
 async def test_a_run_finishes_on_the_clock_and_is_recorded_as_cycles_that_replay(tmp_path: Path) -> None:
-    from liansuo.simulation.recordingfile import load_recording
-    from liansuo.simulation.replayer import Replayer
+    from liansuo.simulation.recording.file import load_recording
+    from liansuo.simulation.recording.replayer import Replayer
 
     path = tmp_path / "run.jsonl"
     app = ConsoleApp("jiaopei", paused=True, record=path)

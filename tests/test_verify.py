@@ -90,7 +90,7 @@ def test_a_broken_interlocking_fails_with_a_script_that_replays_it(monkeypatch: 
     script = Script("replay.yaml", "jiaopei", [ScriptTest("replay", [Step(s, i + 1) for i, s in enumerate(steps)],
                                                           1)])
     station = load("jiaopei")
-    from liansuo.interlocking.table import build_table
+    from liansuo.interlocking.table.build import build_table
 
     outcome = run_test(script, script.tests[0], station, build_table(station))
     assert not outcome.passed and "route X-XI is released, expected locked" in outcome.failure
@@ -106,7 +106,7 @@ def test_a_conflict_the_interlocking_lets_through_is_caught(monkeypatch: pytest.
 def test_waiting_for_nothing_to_happen_lasts_until_the_turnouts_stood_still() -> None:
     # verify's "the signal stays closed" checks wait until the turnouts have been at rest for REST_S: a wait that
     # ended while they still moved would look at a signal that could not have opened yet
-    from liansuo.interlocking.table import build_table
+    from liansuo.interlocking.table.build import build_table
     from liansuo.proving.verify.probe import REST_S, Context, Probe
     from liansuo.rules import load_rules
 
@@ -131,7 +131,7 @@ def test_a_signal_opening_over_a_turnout_without_indication_is_caught_by_its_own
     # an interlocking that takes a turnout whose machine stopped for one in position, and opens without its
     # indication: the signal opens a cycle after the machines stop, which the wait before the check must see
     from liansuo.interlocking.state import RouteStage
-    from liansuo.proving.mutants import MUTANTS
+    from liansuo.proving.mutation.mutants import MUTANTS
 
     def setting(self: RouteLifecycle, rs: object) -> None:
         il = self.il

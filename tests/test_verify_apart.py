@@ -15,10 +15,10 @@ from hypothesis import strategies as hs
 from liansuo.cli.main import main
 from liansuo.interlocking.core import Core
 from liansuo.interlocking.operations import Operator
-from liansuo.interlocking.table import InterlockingTable, build_table
+from liansuo.interlocking.table.build import InterlockingTable, build_table
 from liansuo.proving import verify as verify_module
-from liansuo.proving.mutants import MUTANTS
-from liansuo.proving.mutation import load_station
+from liansuo.proving.mutation.cli import load_station
+from liansuo.proving.mutation.mutants import MUTANTS
 from liansuo.proving.oracle.pairs import PaperOracle
 from liansuo.proving.verify import near_routes, verify_station
 from liansuo.proving.verify.against import spec

@@ -77,13 +77,13 @@ from importlib.resources import files
 print("typed", files("liansuo").joinpath("py.typed").is_file())  # the marker type checkers look for
 table = liansuo.build_table(liansuo.load_station("jiaopei"))
 print("table", len(table.routes), "routes, X-XI conflicts with", ", ".join(sorted(table.routes["X-XI"].conflicts)[:3]))
-from liansuo.proving.mutation import default_stations  # the example stations install too: mutate runs on them
+from liansuo.proving.mutation.cli import default_stations  # the example stations install too: mutate runs on them
 
 print("mutate stations", " ".join(s.rsplit("/", 1)[-1] for s in default_stations()))
 """
 
 EXERCISE_CHECK = """\
-from liansuo.simulation.exercise import bundled_exercises, check_goal, parse_exercise
+from liansuo.classroom.exercise import bundled_exercises, check_goal, parse_exercise
 from liansuo.simulation.sim import Simulation
 
 print("bundled", " ".join(p.stem for p in bundled_exercises()))
@@ -354,7 +354,8 @@ def test_the_pytest_plugin_loads_light_and_runs_scripts(installed: Installed) ->
     loaded = next((line.split("LOADED", 1)[1].split() for line in out.splitlines() if "LOADED" in line), None)
     assert loaded is not None, f"pytest on a plain test printed no LOADED line:\n{out}"
     assert "liansuo.proving.pytest_plugin" in loaded, f"the pytest11 entry point did not load the plugin: {loaded}"
-    heavy = set(loaded) - {"liansuo", "liansuo.proving", "liansuo.proving.pytest_plugin"}
+    heavy = set(loaded) - {"liansuo", "liansuo.proving", "liansuo.proving.pytest_plugin",
+                           "liansuo.kit", "liansuo.kit.native"}  # the pure switch (LIANSUO_PURE=1 in the suite)
     top = sorted({".".join(m.split(".")[:2]) if m.startswith("liansuo.") else m.split(".")[0] for m in heavy})
     assert not heavy, f"a pytest run that collects no script imports {top} ({len(heavy)} modules)"
     (installed.work / "test_routes.yaml").write_text(ROUTE_SCRIPT, encoding="utf-8")

@@ -13,9 +13,8 @@ import numpy as np
 import pytest
 
 from liansuo.bench import report, zpw
-from liansuo.circuits.zpw2000a import (
-    CARRIERS,
-    DEFAULT_PARAMS,
+from liansuo.circuits.zpw.adjust import station_warnings
+from liansuo.circuits.zpw.model import (
     NO_FAULTS,
     SweepResult,
     ZpwCircuit,
@@ -23,16 +22,15 @@ from liansuo.circuits.zpw2000a import (
     ZpwState,
     ZpwTrackRelay,
     capacitor_positions,
-    carrier_frequency_Hz,
     layout_params,
     section_circuit,
     single_faults,
     standard_positions,
     sweep,
 )
-from liansuo.circuits.zpwadjust import station_warnings
+from liansuo.circuits.zpw.params import CARRIERS, DEFAULT_PARAMS, carrier_frequency_Hz
 from liansuo.cli.main import main
-from liansuo.stations.jsonreport import version
+from liansuo.kit.jsonreport import version
 from liansuo.stations.library import bundled
 from liansuo.stations.loader import load, load_text
 

@@ -1,4 +1,4 @@
-"""The ZPW-2000A adjustment table (circuits/zpwadjust.py): the stored table is the model's, every bundled section
+"""The ZPW-2000A adjustment table (circuits/zpw/adjust.py): the stored table is the model's, every bundled section
 adjusted by it detects a standard-shunted train over the design ballast range or `liansuo check` warns for it, and
 the live circuits and `liansuo zpw` apply it (issue 15, item 3)."""
 
@@ -13,8 +13,7 @@ import pytest
 
 from liansuo.circuits.cabcurrent import CabCurrents
 from liansuo.circuits.trackcircuits import build_circuit
-from liansuo.circuits.zpw2000a import LAYOUTS, ZpwFaults, layout_params, standard_positions, sweep_section
-from liansuo.circuits.zpwadjust import (
+from liansuo.circuits.zpw.adjust import (
     adjusted_circuit,
     check_circuit,
     derive_row,
@@ -23,13 +22,14 @@ from liansuo.circuits.zpwadjust import (
     station_verdicts,
     table,
 )
+from liansuo.circuits.zpw.model import LAYOUTS, ZpwFaults, layout_params, standard_positions, sweep_section
 from liansuo.cli.main import main
 from liansuo.stations.library import bundled
 from liansuo.stations.loader import load
 
 
 def test_stored_table_is_the_models() -> None:
-    """The YAML rows are what the model gives for its settings (rebuild with python -m liansuo.circuits.zpwadjust):
+    """The YAML rows are what the model gives for its settings (rebuild with python -m liansuo.circuits.zpw.adjust):
     every layout and carrier, at a short, a middle, the article's and the longest band (the whole table takes a
     minute to derive)."""
     stored = load_table()

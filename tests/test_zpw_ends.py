@@ -1,4 +1,4 @@
-"""The ZPW-2000A system model's ends (circuits/zpwends.py): tuning units designed by their two resonances, the tuning
+"""The ZPW-2000A system model's ends (circuits/zpw/ends.py): tuning units designed by their two resonances, the tuning
 area and the small track (小轨道) with its check, the cable; and the whole section against an independent solver (a
 nodal analysis of a lumped ladder, which shares no code with the chain products it checks)."""
 
@@ -10,8 +10,9 @@ import math
 import numpy as np
 import pytest
 
-from liansuo.circuits.zpw2000a import DEFAULT_PARAMS, ZpwCircuit, ZpwFaults, carrier_frequency_Hz, standard_positions
-from liansuo.circuits.zpwends import PARTNER, unit
+from liansuo.circuits.zpw.ends import PARTNER, section_ends, unit
+from liansuo.circuits.zpw.model import ZpwCircuit, ZpwFaults, standard_positions
+from liansuo.circuits.zpw.params import DEFAULT_PARAMS, ZpwParams, carrier_frequency_Hz
 
 P = DEFAULT_PARAMS
 BASES = ("1700", "2000", "2300", "2600")
@@ -39,10 +40,10 @@ def test_tuning_units_zero_at_the_neighbour_and_pole_with_the_tuning_area(base: 
 def test_the_tuning_area_is_a_few_ohm_at_its_own_carrier(carrier: str) -> None:
     """The pole: the transmitter's own carrier sees a few ohm across the rails in the tuning area, so the signal goes
     into the main track; with insulated joints there is no tuning area."""
-    ends = P.ends(carrier)
+    ends = section_ends(P, carrier)
     assert 1.5 < abs(1 / ends.tx_end_S) < 6.0
     assert ends.small_track != 0
-    insulated = P.__class__(tuning_units=False).ends(carrier)
+    insulated = section_ends(ZpwParams(tuning_units=False), carrier)
     assert insulated.tx_end_S == 0 and insulated.small_track == 0
 
 

@@ -10,11 +10,11 @@ from pathlib import Path
 
 import pytest
 
-from liansuo.circuits.zpw2000a import ZpwCircuit, ZpwFaults, layout_params, standard_positions
-from liansuo.circuits.zpwvalidate import QUANTITIES, TARGET_SHARE, read_article, trend_ok
+from liansuo.circuits.zpw.model import ZpwCircuit, ZpwFaults, layout_params, standard_positions
+from liansuo.circuits.zpw.validate import QUANTITIES, TARGET_SHARE, read_article, trend_ok
 from liansuo.cli.main import main
-from liansuo.stations.fit import columns
-from liansuo.stations.jsonreport import SCHEMAS, version
+from liansuo.kit.fit import columns
+from liansuo.kit.jsonreport import SCHEMAS, version
 
 ROOT = Path(__file__).resolve().parent.parent
 KEYS = ["table", "section", "fault", "quantity", "paper_rise_pct", "paper_fall_pct", "model_rise_pct",

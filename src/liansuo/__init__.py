@@ -22,29 +22,20 @@ does not import the others.
 from __future__ import annotations
 
 import os
-import sys
 from importlib import import_module
-from importlib.machinery import (
-    BYTECODE_SUFFIXES,
-    EXTENSION_SUFFIXES,
-    SOURCE_SUFFIXES,
-    FileFinder,
-    ModuleSpec,
-    SourceFileLoader,
-    SourcelessFileLoader,
-)
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     from liansuo.interlocking.io import Result
-    from liansuo.interlocking.route import InterlockingTable, Route
-    from liansuo.interlocking.table import build_table
+    from liansuo.interlocking.table.build import build_table
+    from liansuo.interlocking.table.route import InterlockingTable, Route
+    from liansuo.kit.native import native_modules, use_pure
+    from liansuo.kit.source import StationError
     from liansuo.proving.verify import VerifyReport, verify_station
     from liansuo.simulation.sim import Simulation
     from liansuo.simulation.unknown import UnknownId
     from liansuo.stations.loader import load as load_station
     from liansuo.stations.loader import load_text as load_station_text
-    from liansuo.stations.source import StationError
     from liansuo.stations.station import Station
 
 __version__ = "0.1.0"
@@ -54,14 +45,16 @@ _WHERE = {
     "Result": ("liansuo.interlocking.io", "Result"),
     "UnknownId": ("liansuo.simulation.unknown", "UnknownId"),
     "Station": ("liansuo.stations.station", "Station"),
-    "StationError": ("liansuo.stations.source", "StationError"),
+    "StationError": ("liansuo.kit.source", "StationError"),
     "load_station": ("liansuo.stations.loader", "load"),
     "load_station_text": ("liansuo.stations.loader", "load_text"),
-    "build_table": ("liansuo.interlocking.table", "build_table"),
-    "InterlockingTable": ("liansuo.interlocking.route", "InterlockingTable"),
-    "Route": ("liansuo.interlocking.route", "Route"),
+    "build_table": ("liansuo.interlocking.table.build", "build_table"),
+    "InterlockingTable": ("liansuo.interlocking.table.route", "InterlockingTable"),
+    "Route": ("liansuo.interlocking.table.route", "Route"),
     "verify_station": ("liansuo.proving.verify", "verify_station"),
     "VerifyReport": ("liansuo.proving.verify", "VerifyReport"),
+    "native_modules": ("liansuo.kit.native", "native_modules"),
+    "use_pure": ("liansuo.kit.native", "use_pure"),
 }
 
 __all__ = ["InterlockingTable", "Result", "Route", "Simulation", "Station", "StationError", "UnknownId",
@@ -69,42 +62,10 @@ __all__ = ["InterlockingTable", "Result", "Route", "Simulation", "Station", "Sta
            "use_pure", "verify_station"]
 
 
-class _PureFinder:
-    """Finds liansuo's modules among its Python sources only, passing over the compiled ones of a native build."""
-
-    def find_spec(self, fullname: str, path: Any = None, target: Any = None) -> ModuleSpec | None:
-        if not fullname.startswith("liansuo.") or path is None:
-            return None
-        for where in path:
-            spec = FileFinder(where, (SourceFileLoader, SOURCE_SUFFIXES),
-                              (SourcelessFileLoader, BYTECODE_SUFFIXES)).find_spec(fullname, target)
-            if spec is not None:
-                return spec
-        return None
-
-
-def native_modules() -> list[str]:
-    """The modules of liansuo loaded so far that run compiled (a native build without LIANSUO_PURE=1)."""
-    return sorted(name for name, mod in list(sys.modules.items()) if name.startswith("liansuo.")
-                  and (getattr(mod, "__file__", None) or "").endswith(tuple(EXTENSION_SUFFIXES)))
-
-
-def use_pure() -> None:
-    """Run the Python sources of liansuo's modules from now on, in this process and the processes it starts. Asked
-    before any of them is imported compiled (the suite's tests/conftest.py), else it raises."""
-    os.environ["LIANSUO_PURE"] = "1"
-    if not any(isinstance(f, _PureFinder) for f in sys.meta_path):
-        sys.meta_path.insert(0, _PureFinder())
-    loaded = native_modules()
-    if loaded:
-        raise RuntimeError(f"liansuo's compiled modules are loaded already ({', '.join(loaded)}): set LIANSUO_PURE=1 "
-                           "in the environment to run the Python sources")
-
-
-# A native build (setup.py, docs/native.md) compiles the hot path with mypyc. LIANSUO_PURE=1 runs the Python sources
-# instead: what replaces a method at run time (``liansuo mutate``'s seeded defects, the suite's doubles) needs them.
+# A native build (kit/native.py, docs/native.md) compiles the hot path with mypyc; LIANSUO_PURE=1 runs the Python
+# sources instead: what replaces a method at run time (liansuo mutate's seeded defects, the suite's doubles) needs them.
 if os.environ.get("LIANSUO_PURE", "") == "1":
-    use_pure()
+    import_module("liansuo.kit.native").use_pure()
 
 
 def __getattr__(name: str) -> Any:

@@ -3,7 +3,7 @@ over and over by an imaginary train that occupies and vacates its sections (the 
 
 from __future__ import annotations
 
-from liansuo.interlocking.table import InterlockingTable, Route
+from liansuo.interlocking.table.build import InterlockingTable, Route
 from liansuo.simulation.sim import Simulation
 
 BUSY_ROUTES = 20

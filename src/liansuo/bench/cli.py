@@ -9,7 +9,7 @@ Add = Callable[..., argparse.ArgumentParser]
 
 
 def cmd_bench(args: argparse.Namespace) -> int:
-    from .report import main  # the benchmark loads the whole simulation: only when it runs
+    from liansuo.bench.report import main  # the benchmark loads the whole simulation: only when it runs
 
     return main(quick=args.quick, fmt=args.format, scale=args.scale, explore=args.explore)
 

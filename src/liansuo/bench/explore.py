@@ -19,8 +19,8 @@ from typing import Any
 
 from liansuo.proving.explore.actions import Bounds
 from liansuo.proving.explore.search import Expander, expand_here, expand_on, search
-from liansuo.proving.mutants import MUTANTS
-from liansuo.proving.mutation import default_stations, first_where_it_shows, load_station
+from liansuo.proving.mutation.cli import default_stations, first_where_it_shows, load_station
+from liansuo.proving.mutation.mutants import MUTANTS
 from liansuo.proving.spread import client
 from liansuo.rules import load_rules
 

@@ -8,20 +8,19 @@ import time
 from dataclasses import dataclass
 from typing import Any
 
-from liansuo import native_modules
-from liansuo.interlocking.table import build_table
+from liansuo.bench.busy import BUSY_ROUTES
+from liansuo.bench.machine import machine
+from liansuo.bench.scale import ScaleSizes, measure_scale
+from liansuo.bench.station import measure
+from liansuo.bench.trains import TARGET_RATIO, TARGET_TRAINS, run_trains, trains_text
+from liansuo.bench.zpw import ZPW_TARGET_CONFIGS_PER_S, measure_zpw
+from liansuo.interlocking.table.build import build_table
+from liansuo.kit.fit import fit_all
+from liansuo.kit.jsonreport import print_report
+from liansuo.kit.native import native_modules
 from liansuo.proving.progress import Advance, progress
-from liansuo.stations.fit import fit_all
 from liansuo.stations.hubgen import generate_hub
-from liansuo.stations.jsonreport import print_report
 from liansuo.stations.loader import load_text
-
-from .busy import BUSY_ROUTES
-from .machine import machine
-from .scale import ScaleSizes, measure_scale
-from .station import measure
-from .trains import TARGET_RATIO, TARGET_TRAINS, run_trains, trains_text
-from .zpw import ZPW_TARGET_CONFIGS_PER_S, measure_zpw
 
 HUB_TURNOUTS = 200
 HUB_TRACKS = 80
@@ -193,7 +192,7 @@ def as_text(report: dict[str, Any]) -> str:
 
 def main(quick: bool = False, fmt: str = "json", scale: bool = False, explore: bool = False) -> int:
     if explore:  # its own run: it takes the better part of an hour in full
-        from .explore import ExploreSizes, measure_explore
+        from liansuo.bench.explore import ExploreSizes, measure_explore
 
         figures = measure_explore(ExploreSizes.quick() if quick else ExploreSizes())
         report: dict[str, Any] = {"benchmark": "liansuo explore", "mode": "quick" if quick else "full",

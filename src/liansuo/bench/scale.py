@@ -21,8 +21,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from liansuo.interlocking.table import build_table
-from liansuo.proving.soakcli import soak_runs
+from liansuo.interlocking.table.build import build_table
+from liansuo.proving.soak.cli import soak_runs
 from liansuo.proving.verify import verify_station
 from liansuo.stations.hubgen import generate_hub
 from liansuo.stations.loader import load_text

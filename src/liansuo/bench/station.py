@@ -7,14 +7,13 @@ import gc
 import time
 from typing import Any, cast
 
+from liansuo.bench.busy import BUSY_ROUTES, Traversal, busy_routes
+from liansuo.bench.machine import peak_rss_mb
 from liansuo.circuits.field import Field
-from liansuo.interlocking.table import build_table
+from liansuo.interlocking.table.build import build_table
 from liansuo.simulation.sim import Simulation
 from liansuo.stations.loader import load, load_text
 from liansuo.stations.station import Station
-
-from .busy import BUSY_ROUTES, Traversal, busy_routes
-from .machine import peak_rss_mb
 
 
 class _TimedField:

@@ -17,7 +17,7 @@ import time
 from dataclasses import dataclass
 from typing import Any
 
-from liansuo.interlocking.table import InterlockingTable, Route
+from liansuo.interlocking.table.build import InterlockingTable, Route
 from liansuo.simulation.sim import Simulation
 from liansuo.simulation.trains.sumo import sumo_installed
 from liansuo.stations.station import Station

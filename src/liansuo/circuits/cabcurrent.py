@@ -1,7 +1,7 @@
 """The code current a cab signal reads at a train's leading wheelset on a ZPW-2000A section.
 
 Station coding sends the code from the end of the section the train runs towards, against the train (ZPW-2000A
-sends against the traffic, :mod:`.zpw2000a`): a train running down reads the current of a transmitter at the section's
+sends against the traffic, :mod:`.zpw.model`): a train running down reads the current of a transmitter at the section's
 upper end, a train running up that of a transmitter at its lower end. The current read is the rail current on the
 transmitter side of the leading wheelset, with the section's faults (compensation capacitors, broken rail, ballast,
 failed insulation) and the wheelset's own shunt resistance (a poor shunt fault raises it). The cab loses the code
@@ -16,8 +16,8 @@ from __future__ import annotations
 
 from bisect import bisect_right
 
-from .trackcircuits import SectionCircuit
-from .zpw2000a import End, ZpwCircuit, ZpwFaults
+from liansuo.circuits.trackcircuits import SectionCircuit
+from liansuo.circuits.zpw.model import End, ZpwCircuit, ZpwFaults
 
 Profile = tuple[list[float], list[float]]  # positions from the section's lower end, cab current mA there
 

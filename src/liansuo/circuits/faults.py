@@ -10,11 +10,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+from liansuo.circuits.physical import ballast_problem
 from liansuo.stations import limits
 from liansuo.stations.limits import Limit
 from liansuo.stations.station import Station
-
-from .physical import ballast_problem
 
 TargetKind = str  # "section", "joint-or-turnout", "signal", "turnout", "platform"
 
@@ -110,7 +109,7 @@ def _param_limit(kind: str, key: str, target: str, station: Station) -> Limit:
 def _capacitors(station: Station, section: str) -> int:
     """How many compensation capacitors the live circuit of a ZPW-2000A section has (built on its span:
     circuits/trackcircuits.py)."""
-    from .zpw2000a import capacitor_positions  # numpy: only for a capacitor fault
+    from liansuo.circuits.zpw.model import capacitor_positions  # numpy: only for a capacitor fault
 
     return len(capacitor_positions(station, section, length_m=max(station.section_span(section), 1.0)))
 

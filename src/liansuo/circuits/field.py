@@ -16,18 +16,17 @@ import math
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 
+from liansuo.circuits.doors import PlatformDoors
+from liansuo.circuits.faults import Fault
+from liansuo.circuits.flasher import ElectronicFlasher, RelayFlasher
+from liansuo.circuits.lamps import SignalLamps
+from liansuo.circuits.leakage import Flicker
+from liansuo.circuits.machines import SwitchMachine
+from liansuo.circuits.railgeometry import Axle, geometry_of
+from liansuo.circuits.shunts import OnTrack, SectionShunts, Shunt, WheelsetGroup, changed_sections
+from liansuo.circuits.trackcircuits import CircuitSpec, SectionCircuit, circuit_spec
 from liansuo.rules import RuleSet, load_rules
 from liansuo.stations.station import Station
-
-from .doors import PlatformDoors
-from .faults import Fault
-from .flasher import ElectronicFlasher, RelayFlasher
-from .lamps import SignalLamps
-from .leakage import Flicker
-from .machines import SwitchMachine
-from .railgeometry import Axle, geometry_of
-from .shunts import OnTrack, SectionShunts, Shunt, WheelsetGroup, changed_sections
-from .trackcircuits import CircuitSpec, SectionCircuit, circuit_spec
 
 
 @dataclass

@@ -11,9 +11,8 @@ operator (计轴复零).
 
 Fail-safe where the model cannot answer: a wheelset at an unknown place (a position that was not a finite number,
 :mod:`.railgeometry`) drops the relay, and a 25 Hz section longer than the model's range (``max_25hz_m``, at most
-:data:`.phase25hz.MAX_LENGTH_M`) is held down for good with the reason in ``held_down``: in dry ballast a standard
-shunt would not drop its relay, so the model could not show a train there.
-"""
+:data:`~liansuo.circuits.phase25.model.MAX_LENGTH_M`) is held down for good with the reason in ``held_down``: in dry
+ballast a standard shunt would not drop its relay, so the model could not show a train there. """
 
 from __future__ import annotations
 
@@ -21,12 +20,11 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
+from liansuo.circuits.axlecounter import AxleCounter
+from liansuo.circuits.phase25.model import MAX_LENGTH_M, Phase25HzCircuit, Phase25HzFaults, adjusted_params
+from liansuo.circuits.shunts import Listed, Shunt, Shunts
 from liansuo.stations.schema import CircuitType
 from liansuo.stations.station import Station
-
-from .axlecounter import AxleCounter
-from .phase25hz import MAX_LENGTH_M, Phase25HzCircuit, Phase25HzFaults, adjusted_params
-from .shunts import Listed, Shunt, Shunts
 
 
 @dataclass
@@ -152,7 +150,7 @@ class SectionCircuit:
             self._voltage = state.voltage_V
             self.up = state.relay_up_after(self.up)
         else:
-            from .zpw2000a import ZpwCircuit, ZpwFaults
+            from liansuo.circuits.zpw.model import ZpwCircuit, ZpwFaults
 
             assert isinstance(self.model, ZpwCircuit)
             zf = ZpwFaults(capacitors=dict(f.capacitors), broken_rail_at_m=_clip(f.broken_rail_at_m, self.length_m),
@@ -215,8 +213,8 @@ def build_circuit(station: Station, section: str, length_m: float, max_25hz_m: f
                                  f"range ({limit:g} m): a train on it might not drop its relay, so it is held "
                                  "occupied; split it with an insulated joint")
         return circuit
-    from .zpw2000a import capacitor_positions, section_layout
-    from .zpwadjust import adjusted_circuit
+    from liansuo.circuits.zpw.adjust import adjusted_circuit
+    from liansuo.circuits.zpw.model import capacitor_positions, section_layout
 
     carrier = sec.carrier or "1700-1"
     caps = sec.capacitors

@@ -13,17 +13,21 @@ from collections.abc import Callable, Sequence
 from functools import partial
 
 from liansuo.bench import cli as bench
-from liansuo.circuits import phase25cli, zpwcli
-from liansuo.cli import completion, exercise, fuzz, schemas
-from liansuo.interlocking import cli as interlocking
+from liansuo.circuits.phase25 import cli as phase25cli
+from liansuo.circuits.zpw import cli as zpwcli
+from liansuo.classroom import cli as exercise
+from liansuo.cli import completion, schemas
+from liansuo.interlocking.table import cli as interlocking
+from liansuo.kit.jsonreport import version
 from liansuo.proving import cli as proving
-from liansuo.proving import mutation, soakcli
 from liansuo.proving.explore import cli as explore
+from liansuo.proving.fuzz import cli as fuzz
+from liansuo.proving.mutation import cli as mutation
+from liansuo.proving.soak import cli as soakcli
 from liansuo.proving.verify import cli as verify
 from liansuo.remote import cli as remote
 from liansuo.server import cli as server
 from liansuo.stations import cli as stations
-from liansuo.stations.jsonreport import version
 from liansuo.tui import cli as tui
 
 Handler = Callable[[argparse.Namespace], int]

@@ -29,7 +29,7 @@ KINDS: dict[str, tuple[str, int, str]] = {
     "station": ("liansuo.stations.schema:StationFile", 1, "liansuo station file"),
     "script": ("liansuo.proving.fileschemas:ScriptFile", 1, "liansuo test script"),
     "scenario": ("liansuo.proving.fileschemas:ScenarioFile", 1, "liansuo scenario"),
-    "exercise": ("liansuo.simulation.exerciseschema:ExerciseFile", 1, "liansuo exercise"),
+    "exercise": ("liansuo.classroom.schema:ExerciseFile", 1, "liansuo exercise"),
 }
 
 

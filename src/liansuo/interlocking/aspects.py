@@ -17,7 +17,7 @@ from liansuo.stations.station import Station
 if TYPE_CHECKING:
     from collections.abc import Callable, Iterable
 
-    from .route import Route, RouteTurnout
+    from liansuo.interlocking.table.route import Route, RouteTurnout
 
 STOP = ("H", "A")
 TRAIN_STOP = "H"

@@ -5,13 +5,12 @@ from __future__ import annotations
 
 from collections.abc import Callable, Collection, Iterable
 
+from liansuo.interlocking.aspects import TRAIN_STOP, at_stop_or_dark, block_aspect
+from liansuo.interlocking.io import Outputs
+from liansuo.interlocking.state import RouteStage, RouteState
 from liansuo.rules import RuleSet
 from liansuo.stations.schema import SignalKind
 from liansuo.stations.station import Station
-
-from .aspects import TRAIN_STOP, at_stop_or_dark, block_aspect
-from .io import Outputs
-from .state import RouteStage, RouteState
 
 
 class AutoBlock:

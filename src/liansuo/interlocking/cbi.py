@@ -10,16 +10,15 @@ from __future__ import annotations
 
 from collections import deque
 
+from liansuo.interlocking.core import Core
+from liansuo.interlocking.io import Alarm, Event, Outputs, RelayBoard
+from liansuo.interlocking.lifecycle import RouteLifecycle
+from liansuo.interlocking.locks import LockLedger
+from liansuo.interlocking.operations import Operator
+from liansuo.interlocking.quiet import Mark, Quiet, quiet_after
+from liansuo.interlocking.state import RouteState
+from liansuo.interlocking.table.route import InterlockingTable
 from liansuo.rules import RuleSet
-
-from .core import Core
-from .io import Alarm, Event, Outputs, RelayBoard
-from .lifecycle import RouteLifecycle
-from .locks import LockLedger
-from .operations import Operator
-from .quiet import Mark, Quiet, quiet_after
-from .route import InterlockingTable
-from .state import RouteState
 
 
 class Interlocking:

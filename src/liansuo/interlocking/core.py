@@ -14,18 +14,17 @@ from collections import deque
 from collections.abc import Iterable
 from dataclasses import dataclass
 
+from liansuo.interlocking.aspects import downgrade, is_open, onward_allows_usu, select_aspect, stop_aspect
+from liansuo.interlocking.autoblock import AutoBlock, cab_codes
+from liansuo.interlocking.block64d import BlockLink, line_pulses_in, line_tracks_changed
+from liansuo.interlocking.io import Alarm, DoorCommand, Event, Outputs, RelayBoard
+from liansuo.interlocking.locks import Hold, LockLedger
+from liansuo.interlocking.state import GuideOnly, RouteStage, RouteState, SignalState, TurnoutState
+from liansuo.interlocking.stationblock import StationBlockLink
+from liansuo.interlocking.table.route import InterlockingTable, Route
 from liansuo.rules import RuleSet, load_rules
 from liansuo.stations.schema import SectionRole
 from liansuo.stations.station import Station
-
-from .aspects import downgrade, is_open, onward_allows_usu, select_aspect, stop_aspect
-from .autoblock import AutoBlock, cab_codes
-from .block64d import BlockLink, line_pulses_in, line_tracks_changed
-from .io import Alarm, DoorCommand, Event, Outputs, RelayBoard
-from .locks import Hold, LockLedger
-from .route import InterlockingTable, Route
-from .state import GuideOnly, RouteStage, RouteState, SignalState, TurnoutState
-from .stationblock import StationBlockLink
 
 MAX_EVENTS = 20_000
 # sections the interlocking locks at power-up (上电锁闭): all of the station's own, not the lines'

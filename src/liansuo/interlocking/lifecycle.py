@@ -18,11 +18,11 @@ what a signal needs to open is the core's (:meth:`~.core.Core.open_blocker`).
 
 from __future__ import annotations
 
-from .aspects import is_open, stop_aspect
-from .core import Core
-from .locks import Hold
-from .route import Route, RunOn
-from .state import GuideOnly, OpenMemo, Reads, ReleaseMemo, RouteStage, RouteState, SettingMemo
+from liansuo.interlocking.aspects import is_open, stop_aspect
+from liansuo.interlocking.core import Core
+from liansuo.interlocking.locks import Hold
+from liansuo.interlocking.state import GuideOnly, OpenMemo, Reads, ReleaseMemo, RouteStage, RouteState, SettingMemo
+from liansuo.interlocking.table.route import Route, RunOn
 
 HANDLERS = {  # the method that runs a route in each stage, one cycle
     RouteStage.setting: "_setting",

@@ -4,15 +4,14 @@ through the route lifecycle (:mod:`.lifecycle`); the routes then progress cycle 
 
 from __future__ import annotations
 
+from liansuo.interlocking.aspects import stop_aspect
+from liansuo.interlocking.core import INTERLOCKED, Core
+from liansuo.interlocking.io import Result
+from liansuo.interlocking.lifecycle import RouteLifecycle
+from liansuo.interlocking.locks import Hold
+from liansuo.interlocking.state import RouteStage, RouteState
+from liansuo.interlocking.table.route import Condition, Kind, Route, RunOn
 from liansuo.stations.schema import Button, SignalKind
-
-from .aspects import stop_aspect
-from .core import INTERLOCKED, Core
-from .io import Result
-from .lifecycle import RouteLifecycle
-from .locks import Hold
-from .route import Condition, Kind, Route, RunOn
-from .state import RouteStage, RouteState
 
 _KIND_WORD = {"train": "train", "shunt": "shunting"}
 

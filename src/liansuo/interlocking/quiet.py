@@ -20,10 +20,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-from .state import RouteStage, TurnoutState
+from liansuo.interlocking.state import RouteStage, TurnoutState
 
 if TYPE_CHECKING:
-    from .core import Changes, Core
+    from liansuo.interlocking.core import Changes, Core
 
 
 @dataclass(frozen=True)

@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 from enum import StrEnum
 from typing import Protocol
 
-from .route import Route, RouteTurnout, RunOn
+from liansuo.interlocking.table.route import Route, RouteTurnout, RunOn
 
 
 class RouteStage(StrEnum):

@@ -14,23 +14,22 @@ from collections.abc import Callable
 from datetime import datetime
 from pathlib import Path
 
+from liansuo.kit.arguments import unwritable
+from liansuo.kit.exitcodes import Exit, bad_input, refuse
+from liansuo.kit.fit import fit_all
+from liansuo.kit.jsonreport import print_report
+from liansuo.kit.plotfiles import add_plot_options, plot_problem, write_rows
+from liansuo.kit.source import StationError
+from liansuo.proving.junit import write_junit
+from liansuo.proving.scenario import ScenarioLog, parse_scenario, run_scenario, station_of
+from liansuo.proving.scripts import Outcome, Script, Unrunnable, parse_script, run_script, script_station, selected
+from liansuo.proving.trainplot import COLUMNS as TRACE_COLUMNS
+from liansuo.proving.trainplot import TrainTrace, draw
 from liansuo.simulation.timeparse import parse_duration
 from liansuo.simulation.trains.sumo import SumoEngineError
 from liansuo.simulation.trains.sumo_export import SumoExportError, SumoUnavailable
 from liansuo.stations import limits
-from liansuo.stations.arguments import unwritable
-from liansuo.stations.exitcodes import Exit, bad_input, refuse
-from liansuo.stations.fit import fit_all
-from liansuo.stations.jsonreport import print_report
-from liansuo.stations.plotfiles import add_plot_options, plot_problem, write_rows
-from liansuo.stations.source import StationError
 from liansuo.stations.station import Station
-
-from .junit import write_junit
-from .scenario import ScenarioLog, parse_scenario, run_scenario, station_of
-from .scripts import Outcome, Script, Unrunnable, parse_script, run_script, script_station, selected
-from .trainplot import COLUMNS as TRACE_COLUMNS
-from .trainplot import TrainTrace, draw
 
 Add = Callable[..., argparse.ArgumentParser]
 FORMATS = ("text", "json")

@@ -19,7 +19,7 @@ from pathlib import Path
 
 from junitparser import Error, Failure, TestCase, TestSuite
 
-from .scripts import Outcome, Unrunnable
+from liansuo.proving.scripts import Outcome, Unrunnable
 
 SUITE = "liansuo"
 

@@ -41,7 +41,7 @@ def pytest_addoption(parser: pytest.Parser) -> None:
 
 _STATION_KEY = re.compile(rb"^station[ \t]*:", re.MULTILINE)
 _TESTS_KEY = re.compile(rb"^tests[ \t]*:", re.MULTILINE)
-_LOOK_BYTES = 16 * 1024 * 1024  # the input limit of every liansuo file (rules/inputlimits.py)
+_LOOK_BYTES = 16 * 1024 * 1024  # the input limit of every liansuo file (kit/inputlimits.py)
 
 
 def is_script(path: Path) -> bool:
@@ -79,10 +79,9 @@ class ScriptFailure(Exception):
 
 class ScriptFile(pytest.File):
     def collect(self) -> Iterator[ScriptItem]:
-        from liansuo.interlocking.table import build_table
-        from liansuo.stations.source import StationError
-
-        from .scripts import parse_script, script_station
+        from liansuo.interlocking.table.build import build_table
+        from liansuo.kit.source import StationError
+        from liansuo.proving.scripts import parse_script, script_station
 
         try:
             script = parse_script(self.path)
@@ -110,7 +109,7 @@ class ScriptItem(pytest.Item):
         self.table = table
 
     def runtest(self) -> None:
-        from .scripts import run_test
+        from liansuo.proving.scripts import run_test
 
         outcome = run_test(self.script, self.test, self.station, self.table)
         if not outcome.passed:

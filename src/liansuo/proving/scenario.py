@@ -20,16 +20,15 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from liansuo.kit.filekind import read_source
+from liansuo.kit.printable import printable
+from liansuo.kit.source import Diagnostic, StationError
+from liansuo.proving.fileschemas import ScenarioFile
 from liansuo.simulation.sim import LANGUAGE, Simulation
-from liansuo.stations.filekind import read_source
 from liansuo.stations.library import resolve_from
 from liansuo.stations.loader import load
-from liansuo.stations.printable import printable
-from liansuo.stations.source import Diagnostic, StationError
 from liansuo.stations.station import Station
 from liansuo.stations.validation import validate
-
-from .fileschemas import ScenarioFile
 
 
 @dataclass

@@ -24,16 +24,15 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from liansuo.interlocking.io import Result
+from liansuo.kit.filekind import read_source
+from liansuo.kit.source import Diagnostic, StationError
+from liansuo.proving.fileschemas import ScriptFile
+from liansuo.proving.oracle import Watch
 from liansuo.simulation.sim import LANGUAGE, Simulation
-from liansuo.stations.filekind import read_source
 from liansuo.stations.library import resolve_from
 from liansuo.stations.loader import load
-from liansuo.stations.source import Diagnostic, StationError
 from liansuo.stations.station import Station
 from liansuo.stations.validation import validate
-
-from .fileschemas import ScriptFile
-from .oracle import Watch
 
 
 @dataclass
@@ -123,7 +122,7 @@ def selected(script: Script, only: str | None) -> list[ScriptTest]:
 def run_script(script: Script, only: str | None = None, station: Station | None = None) -> list[Outcome]:
     """Run the tests ``only`` selects, each on a fresh simulation of the script's station (loaded unless given)."""
     station = station or script_station(script)
-    from liansuo.interlocking.table import build_table
+    from liansuo.interlocking.table.build import build_table
 
     table = build_table(station)
     outcomes = []

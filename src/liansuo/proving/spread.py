@@ -14,7 +14,7 @@ from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from typing import Any, TypeVar
 
-from .progress import Advance
+from liansuo.proving.progress import Advance
 
 T = TypeVar("T")
 R = TypeVar("R")
@@ -42,7 +42,7 @@ def client(workers: int, scheduler: str | None) -> Iterator[Any]:
         with c:
             yield c
         return
-    from .noprofiler import NoProfiler
+    from liansuo.proving.noprofiler import NoProfiler
 
     # the dashboard on any free port; the workers' chatter when the cluster shuts down is silenced
     cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,  # type: ignore[no-untyped-call]

@@ -12,8 +12,8 @@ import math
 from dataclasses import dataclass, field
 from typing import Any
 
+from liansuo.kit.plotfiles import new_figure, save_figure
 from liansuo.simulation.sim import Simulation
-from liansuo.stations.plotfiles import new_figure, save_figure
 
 COLUMNS = ("t_s", "train", "head_track", "head_m", "speed_kmh", "direction", "state")
 

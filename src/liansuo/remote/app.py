@@ -17,15 +17,14 @@ from typing import Any, ClassVar
 from rich.text import Text
 from textual.binding import Binding, BindingType
 
-from liansuo.simulation.roles import INSTRUCTOR
-from liansuo.stations.printable import printable
+from liansuo.classroom.roles import INSTRUCTOR
+from liansuo.kit.printable import printable
+from liansuo.remote.dashboard import DashboardScreen, ExerciseChoice, ExercisePicker
+from liansuo.remote.link import Link, Unlinked
+from liansuo.remote.login import LoginScreen
+from liansuo.remote.sim import LOST, NOT_IN, RemoteSimulation
 from liansuo.tui.app import SPEEDS, ConsoleApp
 from liansuo.tui.instructor import InstructorPanel
-
-from .dashboard import DashboardScreen, ExerciseChoice, ExercisePicker
-from .link import Link, Unlinked
-from .login import LoginScreen
-from .sim import LOST, NOT_IN, RemoteSimulation
 
 
 class RemoteConsoleApp(ConsoleApp):

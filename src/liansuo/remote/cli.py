@@ -12,8 +12,8 @@ import os
 from pathlib import Path
 from typing import Any
 
-from liansuo.simulation.passwords import ENV
-from liansuo.stations.exitcodes import Exit, refuse
+from liansuo.classroom.passwords import ENV
+from liansuo.kit.exitcodes import Exit, refuse
 
 
 class LoginError(ValueError):
@@ -53,9 +53,8 @@ def hello(args: argparse.Namespace) -> dict[str, Any] | None:
 
 
 def cmd_connect(args: argparse.Namespace) -> int:
+    from liansuo.remote.link import Link, LinkError, Unlinked, lobby
     from liansuo.tui.cli import closed
-
-    from .link import Link, LinkError, Unlinked, lobby
 
     try:
         greeting = hello(args)
@@ -68,7 +67,7 @@ def cmd_connect(args: argparse.Namespace) -> int:
             else Link(args.connect, greeting)
     except LinkError as exc:
         return refuse("tui", str(exc), Exit.USAGE)
-    from .app import RemoteConsoleApp
+    from liansuo.remote.app import RemoteConsoleApp
 
     app = RemoteConsoleApp(link, mute=args.mute)
     try:

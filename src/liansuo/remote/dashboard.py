@@ -21,11 +21,10 @@ from textual.message import Message
 from textual.screen import ModalScreen, Screen
 from textual.widgets import Button, DataTable, Footer, Label, OptionList, Select, Static
 
-from liansuo.simulation.exercise import bundled_exercises
-from liansuo.stations.printable import printable
+from liansuo.classroom.exercise import bundled_exercises
+from liansuo.kit.printable import printable
+from liansuo.remote.link import Link
 from liansuo.tui.panels import clock_text
-
-from .link import Link
 
 COLUMNS = ("seat", "trainee", "connected", "station", "t", "clock", "exercise", "progress", "score", "alarms",
            "refused")

@@ -17,9 +17,8 @@ from textual.containers import Vertical
 from textual.screen import ModalScreen
 from textual.widgets import Button, Input, Label, RadioButton, RadioSet, Static
 
-from liansuo.stations.printable import printable
-
-from .link import Link, LinkError
+from liansuo.kit.printable import printable
+from liansuo.remote.link import Link, LinkError
 
 
 def hello_of(role: str, name: str, seat: str, password: str) -> dict[str, Any] | str:

@@ -15,17 +15,16 @@ from collections import deque
 from dataclasses import dataclass
 from typing import Any
 
+from liansuo.classroom.snapshot import SnapshotView
 from liansuo.interlocking.io import Event, Result
-from liansuo.interlocking.table import InterlockingTable, build_table
+from liansuo.interlocking.table.build import InterlockingTable, build_table
+from liansuo.remote.link import Link, Unlinked
 from liansuo.rules import RuleSet, load_rules
 from liansuo.simulation.language import Language
 from liansuo.simulation.sim import LANGUAGE, Simulation
-from liansuo.simulation.snapshot import SnapshotView
 from liansuo.simulation.view import AlarmView, TrainView
 from liansuo.stations.loader import load, load_text
 from liansuo.stations.station import Station
-
-from .link import Link, Unlinked
 
 LOST = "connection to the classroom server lost, reconnecting"
 NOT_IN = "not logged in to the classroom yet"

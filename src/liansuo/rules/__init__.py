@@ -7,11 +7,9 @@
 - ``aspects.yaml``: ``rules.aspects``, the aspects by role, their lamps and colours, downgrades and cab codes;
 - ``driving.yaml``: ``rules.driving``; ``design.yaml``: ``rules.design``; ``equipment.yaml``: ``rules.equipment``.
 
-This is the bottom layer: it imports none of the others, so every layer may read it (docs/rules.md). It holds rule
-data and its validation only, and the one YAML reader that reads them and every other liansuo file within the input
-limits (:mod:`.safeyaml`, :mod:`.inputlimits`), never rule code: the Chinese aspect selection lives in
-``interlocking/aspects.py``, and the safety oracle, which may read this package, shares none of that code.
-"""
+It stands on the kit alone (the bounded YAML reader, :mod:`~liansuo.kit.safeyaml`), so every layer above may read
+it (docs/rules.md). It holds rule data and its validation only, never rule code: the Chinese aspect selection lives
+in ``interlocking/aspects.py``, and the safety oracle, which may read this package, shares none of that code."""
 
 from __future__ import annotations
 
@@ -21,9 +19,17 @@ from pathlib import Path
 
 from pydantic import BaseModel
 
-from .aspects import DARK, Aspects
-from .parts import ApproachLocking, DesignRules, DoorSpec, DrivingRules, Equipment, InterlockingRules, MachineSpec
-from .reader import Problem, RuleError, RuleFile, read, validate
+from liansuo.rules.aspects import DARK, Aspects
+from liansuo.rules.parts import (
+    ApproachLocking,
+    DesignRules,
+    DoorSpec,
+    DrivingRules,
+    Equipment,
+    InterlockingRules,
+    MachineSpec,
+)
+from liansuo.rules.reader import Problem, RuleError, RuleFile, read, validate
 
 DEFAULT = "china"  # the rule set used where none is chosen
 BUNDLED = Path(str(files("liansuo.rules")))  # package data, installed with liansuo

@@ -11,7 +11,7 @@ from typing import Annotated
 
 from pydantic import BaseModel, ConfigDict, Field, PrivateAttr
 
-from .reader import Loc
+from liansuo.rules.reader import Loc
 
 DARK = ""  # what the interlocking and the field call a signal with no aspect: nothing lit, taken as stop
 

@@ -12,7 +12,7 @@ from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
-from .reader import Loc
+from liansuo.rules.reader import Loc
 
 Seconds = Annotated[float, Field(gt=0)]
 Metres = Annotated[float, Field(gt=0)]

@@ -1,6 +1,6 @@
 """Reading a rule file while remembering where each value stands, so that bad rule data is reported as
-``FILE:LINE:COLUMN: error: message``, the way station files are: both are read by :mod:`.safeyaml`, within the
-same limits."""
+``FILE:LINE:COLUMN: error: message``, the way station files are: both are read by :mod:`~liansuo.kit.safeyaml`, within
+the same limits."""
 
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ from typing import Any, TypeVar
 
 from pydantic import BaseModel, ValidationError
 
-from .safeyaml import Loc, Mark, YamlProblem, build, compose, read_file
+from liansuo.kit.safeyaml import Loc, Mark, YamlProblem, build, compose, read_file
 
 M = TypeVar("M", bound=BaseModel)
 __all__ = ["Loc", "Problem", "RuleError", "RuleFile", "read", "validate"]

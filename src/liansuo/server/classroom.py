@@ -15,15 +15,15 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from liansuo.classroom.assessment import Assessment, ExerciseSetupError
+from liansuo.classroom.exercise import DIFFICULTIES, bundled_exercises, parse_exercise
+from liansuo.classroom.report import write_report
+from liansuo.classroom.roles import INSTRUCTOR, refusal
+from liansuo.classroom.snapshot import EventCursor, snapshot
 from liansuo.interlocking.io import Result
-from liansuo.simulation.assessment import Assessment, ExerciseSetupError
-from liansuo.simulation.assessmentreport import write_report
-from liansuo.simulation.exercise import DIFFICULTIES, bundled_exercises, parse_exercise
-from liansuo.simulation.roles import INSTRUCTOR, refusal
+from liansuo.kit.source import StationError
 from liansuo.simulation.sim import Simulation
-from liansuo.simulation.snapshot import EventCursor, snapshot
 from liansuo.stations.library import bundled
-from liansuo.stations.source import StationError
 
 MAX_STEPS = 400  # cycles one seat may catch up in one advance: a stalled server does not freeze on its return
 

@@ -12,11 +12,11 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from liansuo.stations.exitcodes import Exit, bad_input, refuse
-from liansuo.stations.source import StationError
+from liansuo.kit.exitcodes import Exit, bad_input, refuse
+from liansuo.kit.source import StationError
 
 if TYPE_CHECKING:
-    from .websocket import ClassroomServer
+    from liansuo.server.websocket import ClassroomServer
 
 Handler = Callable[[argparse.Namespace], int]
 Add = Callable[[str, Handler, str], argparse.ArgumentParser]
@@ -53,7 +53,7 @@ def register(add: Add) -> None:
 
 
 def cmd_serve(args: argparse.Namespace) -> int:
-    from liansuo.simulation.passwords import PasswordError, hash_password, instructor_hash
+    from liansuo.classroom.passwords import PasswordError, hash_password, instructor_hash
 
     if args.hash_password:
         pw = getpass.getpass("instructor password: ") if sys.stdin.isatty() else sys.stdin.readline().rstrip("\n")
@@ -78,8 +78,8 @@ def cmd_serve(args: argparse.Namespace) -> int:
     missing = [d for d in args.exercise_dir if not Path(d).is_dir()]
     if missing:
         return refuse("serve", f"--exercise-dir {missing[0]}: no such directory", Exit.USAGE)
-    from .classroom import Classroom, SeatError
-    from .websocket import ClassroomServer
+    from liansuo.server.classroom import Classroom, SeatError
+    from liansuo.server.websocket import ClassroomServer
 
     try:
         classroom = Classroom(args.station, args.seats, shared=args.shared, reports=Path(args.reports),
@@ -128,7 +128,7 @@ async def _serve(server: ClassroomServer, host: str, port: int, web_port: int | 
     browsers = ""
     web = None
     if web_port is not None:
-        from . import web as webserver
+        from liansuo.server import web as webserver
 
         web = webserver.start(webserver.local_url(host, ready.result()), host, web_port, public_url)
         browsers = f", browsers on {public_url or f'http://{host}:{web_port}'}"

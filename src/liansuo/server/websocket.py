@@ -20,12 +20,11 @@ from pydantic import ValidationError
 from websockets.asyncio.server import ServerConnection, serve
 from websockets.exceptions import ConnectionClosed
 
-from liansuo.simulation.passwords import matches
-from liansuo.simulation.roles import INSTRUCTOR, TRAINEE
-from liansuo.simulation.snapshot import EventCursor
-
-from .classroom import Classroom, SeatError
-from .messages import MESSAGE, ClientMessage, Clock, Command, Exercise, Hello, Lobby, Stop, Watch, problem
+from liansuo.classroom.passwords import matches
+from liansuo.classroom.roles import INSTRUCTOR, TRAINEE
+from liansuo.classroom.snapshot import EventCursor
+from liansuo.server.classroom import Classroom, SeatError
+from liansuo.server.messages import MESSAGE, ClientMessage, Clock, Command, Exercise, Hello, Lobby, Stop, Watch, problem
 
 TICK_S = 0.05  # the clocks' pace on the wall clock
 PUSH_S = 0.25  # a snapshot to each client this often

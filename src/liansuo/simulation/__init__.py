@@ -11,7 +11,6 @@ Python API::
 """
 
 from liansuo.interlocking.io import Result
-
-from .sim import Simulation
+from liansuo.simulation.sim import Simulation
 
 __all__ = ["Result", "Simulation"]

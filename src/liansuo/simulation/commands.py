@@ -12,12 +12,11 @@ from collections.abc import Callable
 from liansuo.circuits.faults import KINDS, parse_fault
 from liansuo.circuits.railgeometry import Axle
 from liansuo.interlocking.io import Result
-from liansuo.interlocking.table import Kind
+from liansuo.interlocking.table.build import Kind
+from liansuo.simulation.language import Command
+from liansuo.simulation.timeparse import parse_duration
+from liansuo.simulation.world import World
 from liansuo.stations import limits
-
-from .language import Command
-from .timeparse import parse_duration
-from .world import World
 
 Handler = Callable[[World, list[str]], Result]
 

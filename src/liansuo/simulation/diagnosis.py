@@ -1,7 +1,7 @@
 """``diagnose KIND ELEMENT``: the trainee registers what they found, as a signaller writes it in the equipment
-register (行车设备检查登记簿). It records the finding in the world's log and changes nothing else: the fault stays
-until the instructor (the maintainer) repairs it. An assessment (:mod:`.assessment`) compares the registered
-findings with the faults it injected.
+register (行车设备检查登记簿). It records the finding in the world's log and changes nothing else: the
+fault stays until the instructor (the maintainer) repairs it. An assessment (:mod:`~liansuo.classroom.assessment`)
+compares the registered findings with the faults it injected.
 
 KIND is a fault kind (docs/faults.md: ``broken-rail``, ``filament``, ``no-indication`` ...), ``red-band`` (a section
 shows occupied with no train in it, whatever the cause: what the console shows of a broken rail, low ballast or a
@@ -13,10 +13,9 @@ from __future__ import annotations
 
 from liansuo.circuits.faults import KINDS
 from liansuo.interlocking.io import Result
-
-from .language import Command
-from .unknown import UnknownId, close_matches
-from .world import World
+from liansuo.simulation.language import Command
+from liansuo.simulation.unknown import UnknownId, close_matches
+from liansuo.simulation.world import World
 
 DIAGNOSIS_KINDS: tuple[str, ...] = (*KINDS, "red-band", "dead-zone")
 USAGE = "diagnose KIND ELEMENT"

@@ -7,10 +7,9 @@ from __future__ import annotations
 
 from liansuo.interlocking.io import Result
 from liansuo.interlocking.state import RouteStage
+from liansuo.simulation.language import Command
+from liansuo.simulation.world import World
 from liansuo.stations import limits
-
-from .language import Command
-from .world import World
 
 USAGE = "expect signal|route|turnout|section|refused|accepted|alarm|no-alarm|block-line|code|cab|odometry ..."
 CAB_WORDS = ("none", "lost", "wrong-carrier")  # what 'expect cab' takes besides a code

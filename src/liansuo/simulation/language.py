@@ -18,9 +18,8 @@ from dataclasses import dataclass
 from typing import Generic, TypeVar
 
 from liansuo.interlocking.io import Result
-from liansuo.stations.source import Diagnostic, Source
-
-from .unknown import UnknownId
+from liansuo.kit.source import Diagnostic, Source
+from liansuo.simulation.unknown import UnknownId
 
 W = TypeVar("W")
 W_contra = TypeVar("W_contra", contravariant=True)

@@ -13,15 +13,14 @@ Python API::
 from __future__ import annotations
 
 from liansuo.interlocking.io import Result
-
-from .commands import WORLD_COMMANDS
-from .diagnosis import DIAGNOSE
-from .expect import EXPECT
-from .language import Language
-from .trains import ato, automatic
-from .trains.commands import TRAIN_COMMANDS
-from .trains.fleet import Train
-from .world import World
+from liansuo.simulation.commands import WORLD_COMMANDS
+from liansuo.simulation.diagnosis import DIAGNOSE
+from liansuo.simulation.expect import EXPECT
+from liansuo.simulation.language import Language
+from liansuo.simulation.trains import ato, automatic
+from liansuo.simulation.trains.commands import TRAIN_COMMANDS
+from liansuo.simulation.trains.fleet import Train
+from liansuo.simulation.world import World
 
 LANGUAGE: Language[Simulation] = Language(WORLD_COMMANDS, [DIAGNOSE], [EXPECT], TRAIN_COMMANDS)
 

@@ -20,8 +20,7 @@ from liansuo.interlocking.cbi import Interlocking
 from liansuo.interlocking.io import Event, Outputs, RelayBoard
 from liansuo.interlocking.locks import Hold
 from liansuo.interlocking.state import RouteStage, RouteState
-
-from .unknown import require
+from liansuo.simulation.unknown import require
 
 # alarm kinds of the interlocking that concern a signal (the console marks its name)
 SIGNAL_ALARMS = frozenset({"closed", "lamp", "red", "filament", "flasher"})

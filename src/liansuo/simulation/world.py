@@ -19,20 +19,19 @@ from liansuo.circuits.field import Field
 from liansuo.circuits.railgeometry import Axle
 from liansuo.interlocking.cbi import Interlocking
 from liansuo.interlocking.io import Event, Result
-from liansuo.interlocking.table import InterlockingTable, build_table
+from liansuo.interlocking.table.build import InterlockingTable, build_table
 from liansuo.rules import RuleSet, load_rules
+from liansuo.simulation.neighbour import Neighbours
+from liansuo.simulation.trains.cabsignal import ATP
+from liansuo.simulation.trains.engine import MotionEngine
+from liansuo.simulation.trains.engines import attach_engine, make_engine
+from liansuo.simulation.trains.fleet import Fleet, Train
+from liansuo.simulation.trains.movement import OUTSIDE
+from liansuo.simulation.unknown import UnknownId, close_matches
+from liansuo.simulation.view import AlarmView, CabView, InterlockingView, TrainView
+from liansuo.simulation.wiring import Wiring
 from liansuo.stations.loader import load
 from liansuo.stations.station import Station
-
-from .neighbour import Neighbours
-from .trains.cabsignal import ATP
-from .trains.engine import MotionEngine
-from .trains.engines import attach_engine, make_engine
-from .trains.fleet import Fleet, Train
-from .trains.movement import OUTSIDE
-from .unknown import UnknownId, close_matches
-from .view import AlarmView, CabView, InterlockingView, TrainView
-from .wiring import Wiring
 
 
 class World:

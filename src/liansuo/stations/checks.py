@@ -11,10 +11,11 @@ from itertools import pairwise
 
 import networkx as nx
 
-from . import limits
-from .crossovers import undeclared_crossings
-from .fit import metres, number
-from .schema import (
+from liansuo.kit.fit import metres, number
+from liansuo.kit.source import Diagnostic, Loc, Source
+from liansuo.stations import limits
+from liansuo.stations.crossovers import undeclared_crossings
+from liansuo.stations.schema import (
     Button,
     CircuitType,
     Direction,
@@ -26,8 +27,7 @@ from .schema import (
     SignalKind,
     StationFile,
 )
-from .source import Diagnostic, Loc, Source
-from .station import LEGS, Port, Station, parse_port
+from liansuo.stations.station import LEGS, Port, Station, parse_port
 
 
 class _Checker:

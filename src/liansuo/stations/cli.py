@@ -8,15 +8,15 @@ import argparse
 import sys
 from collections.abc import Callable
 
-from .arguments import positive_int, unwritable
-from .exitcodes import Exit, bad_input, refuse
-from .fit import fit
-from .jsonreport import print_report
-from .library import bundled, describe
-from .loader import load
-from .source import Diagnostic, StationError
-from .station import Station
-from .summary import summarise, summary_text
+from liansuo.kit.arguments import positive_int, unwritable
+from liansuo.kit.exitcodes import Exit, bad_input, refuse
+from liansuo.kit.fit import fit
+from liansuo.kit.jsonreport import print_report
+from liansuo.kit.source import Diagnostic, StationError
+from liansuo.stations.library import bundled, describe
+from liansuo.stations.loader import load
+from liansuo.stations.station import Station
+from liansuo.stations.summary import summarise, summary_text
 
 Add = Callable[..., argparse.ArgumentParser]
 FORMATS = ("text", "json")
@@ -62,8 +62,8 @@ def cmd_generate(args: argparse.Namespace) -> int:
     """A generated hub station file (the benchmark's), on stdout or in ``-o FILE``."""
     from pathlib import Path
 
-    from .hubgen import generate_hub
-    from .loader import load_text
+    from liansuo.stations.hubgen import generate_hub
+    from liansuo.stations.loader import load_text
 
     if args.output and (why := unwritable(Path(args.output))):
         return refuse("generate hub", why, Exit.USAGE)
@@ -88,8 +88,8 @@ def cmd_generate(args: argparse.Namespace) -> int:
 
 def register(add: Add, more_warnings: tuple[Warnings, ...] = (), more_errors: tuple[Warnings, ...] = ()) -> None:
     """Add ``stations``, ``check`` and ``generate``; ``more_warnings``: design checks of higher layers that
-    ``check`` adds to the station's own (the track-circuit physics: ``circuits/zpwcli.py``); ``more_errors``: what
-    higher layers refuse in a station that loaded (the interlocking table: ``interlocking/cli.py``), so that
+    ``check`` adds to the station's own (the track-circuit physics: ``circuits/zpw/cli.py``); ``more_errors``: what
+    higher layers refuse in a station that loaded (the interlocking table: ``interlocking/table/cli.py``), so that
     ``check`` accepts only what every command accepts."""
     sp = add("stations", cmd_stations, "list the bundled stations")
     sp.add_argument("--format", choices=FORMATS, default="text", help="text (default) or json")

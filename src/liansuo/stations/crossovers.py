@@ -19,8 +19,8 @@ from itertools import combinations
 
 import networkx as nx
 
-from .schema import StationFile
-from .station import Port, parse_port
+from liansuo.stations.schema import StationFile
+from liansuo.stations.station import Port, parse_port
 
 
 @dataclass(frozen=True)

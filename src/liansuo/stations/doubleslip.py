@@ -32,9 +32,9 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 
-from .schema import Diamond, DoubleSlip, StationFile, Track, Turnout
-from .source import Diagnostic, Loc, Mark, Source
-from .station import parse_port
+from liansuo.kit.source import Diagnostic, Loc, Mark, Source
+from liansuo.stations.schema import Diamond, DoubleSlip, StationFile, Track, Turnout
+from liansuo.stations.station import parse_port
 
 KEY = "double_slips"
 

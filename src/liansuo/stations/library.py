@@ -5,9 +5,8 @@ from __future__ import annotations
 from importlib.resources import files
 from pathlib import Path
 
-from liansuo.rules.safeyaml import YamlProblem, build, compose, read_file
-
-from .printable import printable
+from liansuo.kit.printable import printable
+from liansuo.kit.safeyaml import YamlProblem, build, compose, read_file
 
 LIBRARY = Path(str(files("liansuo.stations") / "library"))  # package data, installed with liansuo
 DEFAULT_STATION = "jiaopei"

@@ -16,7 +16,7 @@ from typing import Any
 
 from pydantic import AfterValidator, Field
 
-from .fit import number
+from liansuo.kit.fit import number
 
 
 @dataclass(frozen=True)

@@ -12,17 +12,16 @@ from pathlib import Path
 
 from pydantic import ValidationError
 
+from liansuo.kit.filekind import check_kind, read_source
+from liansuo.kit.source import Source, StationError, read_yaml
 from liansuo.rules import RuleSet
-
-from .checks import cross_check
-from .doubleslip import double_slip_errors, expand_double_slips
-from .filekind import check_kind, read_source
-from .library import resolve
-from .rules import design_warnings
-from .schema import StationFile
-from .source import Source, StationError, read_yaml
-from .station import Station
-from .validation import schema_diagnostics
+from liansuo.stations.checks import cross_check
+from liansuo.stations.doubleslip import double_slip_errors, expand_double_slips
+from liansuo.stations.library import resolve
+from liansuo.stations.rules import design_warnings
+from liansuo.stations.schema import StationFile
+from liansuo.stations.station import Station
+from liansuo.stations.validation import schema_diagnostics
 
 
 def parse_source(src: Source, rules: RuleSet | None = None) -> Station:

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from .schema import Direction, Grade
+from liansuo.stations.schema import Direction, Grade
 
 
 def mean_gradient(profile: Sequence[Grade], a: float, b: float) -> float:

@@ -8,12 +8,11 @@ from __future__ import annotations
 from functools import cached_property
 from itertools import pairwise
 
+from liansuo.kit.fit import metres
+from liansuo.kit.source import Diagnostic, Loc
 from liansuo.rules import DesignRules, load_rules
-
-from .fit import metres
-from .schema import CircuitType, Direction, FoulingPoint, JointKind, Signal, SignalKind
-from .source import Diagnostic, Loc
-from .station import Station
+from liansuo.stations.schema import CircuitType, Direction, FoulingPoint, JointKind, Signal, SignalKind
+from liansuo.stations.station import Station
 
 
 def design_rules() -> DesignRules:

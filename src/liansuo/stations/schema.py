@@ -13,9 +13,8 @@ from typing import Annotated, Literal
 
 from pydantic import AfterValidator, BaseModel, BeforeValidator, ConfigDict, Field, WithJsonSchema
 
-from liansuo.rules.inputlimits import LIMITS
-
-from . import limits
+from liansuo.kit.inputlimits import LIMITS
+from liansuo.stations import limits
 
 _ID_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_\-/]*$")
 _KM_RE = re.compile(r"^K(\d+)\+(\d+(?:\.\d+)?)$")

@@ -7,8 +7,9 @@ from dataclasses import dataclass
 from functools import cached_property
 from typing import TYPE_CHECKING, Any, TypeVar, overload
 
-from .printable import printable
-from .schema import (
+from liansuo.kit.printable import printable
+from liansuo.kit.source import Diagnostic, Source
+from liansuo.stations.schema import (
     Direction,
     End,
     FoulingPoint,
@@ -21,12 +22,10 @@ from .schema import (
     Track,
     Turnout,
 )
-from .source import Diagnostic, Source
 
 if TYPE_CHECKING:
     from liansuo.rules import DesignRules, RuleSet
-
-    from .topology import Topology
+    from liansuo.stations.topology import Topology
 
 LEGS = ("point", "normal", "reverse")
 T = TypeVar("T")
@@ -317,11 +316,11 @@ class Station:
         return self.sections[section].role is SectionRole.station_track
 
     def display_name(self) -> str:
-        """The name for a heading, control characters written out (:func:`~.printable.printable`)."""
+        """The name for a heading, control characters written out (:func:`~liansuo.kit.printable.printable`)."""
         return printable(f"{self.model.name.zh} ({self.model.name.en})")
 
     @cached_property
     def topology(self) -> Topology:
-        from .topology import Topology  # networkx loads on first use: checking a file needs no graph
+        from liansuo.stations.topology import Topology  # networkx loads on first use: checking a file needs no graph
 
         return Topology(self)

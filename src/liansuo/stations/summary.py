@@ -5,8 +5,8 @@ from __future__ import annotations
 from collections import Counter
 from typing import Any
 
-from .fit import fit_all, metres, number
-from .station import Station
+from liansuo.kit.fit import fit_all, metres, number
+from liansuo.stations.station import Station
 
 
 def summarise(station: Station) -> dict[str, Any]:

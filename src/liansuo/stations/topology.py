@@ -19,7 +19,7 @@ from typing import Protocol
 
 import networkx as nx
 
-from .schema import Direction, Joint, Signal, Track, Turnout, TurnoutPosition
+from liansuo.stations.schema import Direction, Joint, Signal, Track, Turnout, TurnoutPosition
 
 Move = tuple[str, Direction]
 

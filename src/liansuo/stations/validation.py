@@ -10,7 +10,7 @@ from typing import Any, TypeVar
 
 from pydantic import BaseModel, ValidationError
 
-from .source import Diagnostic, Source
+from liansuo.kit.source import Diagnostic, Source
 
 M = TypeVar("M", bound=BaseModel)
 

@@ -24,26 +24,25 @@ from textual.binding import Binding, BindingType
 from textual.containers import Horizontal, Vertical
 from textual.widgets import Footer, Input
 
+from liansuo.classroom.exercise import Exercise, GoalCheck, bundled_exercises, check_goal, parse_exercise
+from liansuo.classroom.passwords import ENV, hash_password, matches
+from liansuo.classroom.roles import INSTRUCTOR, TRAINEE, command_word, refusal
+from liansuo.kit.printable import printable
+from liansuo.kit.source import StationError
 from liansuo.simulation import Result
-from liansuo.simulation.exercise import Exercise, GoalCheck, bundled_exercises, check_goal, parse_exercise
-from liansuo.simulation.passwords import ENV, hash_password, matches
-from liansuo.simulation.recording import FileRecorder
-from liansuo.simulation.roles import INSTRUCTOR, TRAINEE, command_word, refusal
+from liansuo.simulation.recording.recorder import FileRecorder
 from liansuo.simulation.sim import Simulation
-from liansuo.stations.printable import printable
-from liansuo.stations.source import StationError
-
-from .completion import example_route
-from .consolesim import ConsoleSim
-from .describe import describe
-from .diagram import Diagram
-from .dialogs import ConfirmScreen, HelpScreen, MenuScreen, PasswordScreen
-from .incidents import KEY_PREFIX, Incident
-from .instructor import InstructorPanel
-from .layout import Ref
-from .longrun import LongRun, requested_run
-from .operate import MODES, Operator, Outcome
-from .panels import (
+from liansuo.tui.completion import example_route
+from liansuo.tui.consolesim import ConsoleSim
+from liansuo.tui.describe import describe
+from liansuo.tui.diagram import Diagram
+from liansuo.tui.dialogs import ConfirmScreen, HelpScreen, MenuScreen, PasswordScreen
+from liansuo.tui.incidents import KEY_PREFIX, Incident
+from liansuo.tui.instructor import InstructorPanel
+from liansuo.tui.layout import Ref
+from liansuo.tui.longrun import LongRun, requested_run
+from liansuo.tui.operate import MODES, Operator, Outcome
+from liansuo.tui.panels import (
     AlarmBell,
     AlarmLine,
     AlarmPanel,
@@ -57,7 +56,7 @@ from .panels import (
     read_alarms,
     waiting_text,
 )
-from .safeapp import SafeApp
+from liansuo.tui.safeapp import SafeApp
 
 SPEEDS = (0.25, 0.5, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0, 64.0)
 TICK_S = 0.125  # redraw at 8 Hz: often enough for the USU flash (35 per minute)

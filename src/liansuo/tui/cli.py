@@ -14,16 +14,15 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from liansuo.stations.arguments import positive_number, unwritable
-from liansuo.stations.exitcodes import Exit, bad_input, refuse
-from liansuo.stations.printable import printable
-from liansuo.stations.source import StationError
+from liansuo.kit.arguments import positive_number, unwritable
+from liansuo.kit.exitcodes import Exit, bad_input, refuse
+from liansuo.kit.printable import printable
+from liansuo.kit.source import StationError
 from liansuo.stations.station import Station
 
 if TYPE_CHECKING:
-    from liansuo.simulation.recordingfile import Recording
-
-    from .safeapp import SafeApp
+    from liansuo.simulation.recording.file import Recording
+    from liansuo.tui.safeapp import SafeApp
 
 Handler = Callable[[argparse.Namespace], int]
 Add = Callable[[str, Handler, str], argparse.ArgumentParser]
@@ -90,7 +89,7 @@ def cmd_tui(args: argparse.Namespace) -> int:
     if args.record and (why := unwritable(Path(args.record), "--record")):
         return refuse("tui", why, Exit.USAGE)
     if args.exercise:
-        from liansuo.simulation.exercise import parse_exercise
+        from liansuo.classroom.exercise import parse_exercise
 
         try:
             ex = parse_exercise(args.exercise)
@@ -101,13 +100,13 @@ def cmd_tui(args: argparse.Namespace) -> int:
                           f"'liansuo tui {ex.station} --exercise {args.exercise}'", Exit.USAGE)
     stored = None
     if args.password_file:
-        from liansuo.simulation.passwords import PasswordError, instructor_hash
+        from liansuo.classroom.passwords import PasswordError, instructor_hash
 
         try:
             stored = instructor_hash(args.password_file)
         except PasswordError as exc:
             return refuse("tui", str(exc), Exit.USAGE)
-    from .app import ConsoleApp
+    from liansuo.tui.app import ConsoleApp
 
     try:
         app = ConsoleApp(args.station, paused=args.paused, speed=args.speed, record=args.record,
@@ -148,7 +147,7 @@ def closed(app: SafeApp, command: str) -> int:
 
 
 def cmd_replay(args: argparse.Namespace) -> int:
-    from liansuo.simulation.recordingfile import RecordingError, load_recording, recording_station
+    from liansuo.simulation.recording.file import RecordingError, load_recording, recording_station
 
     if args.format == "json" and not args.verify:
         return refuse("replay", "--format json goes with --verify (the console has no JSON)", Exit.USAGE)
@@ -161,7 +160,7 @@ def cmd_replay(args: argparse.Namespace) -> int:
         return bad_input(exc, f"station of {printable(args.file)}")
     if args.verify:
         return _verify(args, rec, station)
-    from .replay import ReplayApp
+    from liansuo.tui.replay import ReplayApp
 
     replay = ReplayApp(rec, station, speed=args.speed)
     replay.run()
@@ -170,18 +169,18 @@ def cmd_replay(args: argparse.Namespace) -> int:
 
 def _verify(args: argparse.Namespace, rec: Recording, station: Station) -> int:
     """``replay --verify``: the whole recording re-simulated, every mismatch listed; 1 when there is one."""
-    from liansuo.simulation.replayer import Replayer
+    from liansuo.simulation.recording.replayer import Replayer
 
     bad = Replayer(rec, station).verify()
     cmds = len(rec.commands)
     if args.format == "json":
-        from liansuo.stations.jsonreport import print_report
+        from liansuo.kit.jsonreport import print_report
 
         print_report("replay", not bad, {"recording": rec.path, "station": rec.station, "cycles": rec.cycles,
                                          "duration_s": round(rec.duration, 2), "commands": cmds,
                                          "mismatches": bad})
     else:
-        from liansuo.stations.fit import fit, plural
+        from liansuo.kit.fit import fit, plural
 
         for line in bad:
             print(fit(printable(line)))

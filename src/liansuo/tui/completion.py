@@ -10,7 +10,7 @@ import re
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from .consolesim import ConsoleSim
+    from liansuo.tui.consolesim import ConsoleSim
 
 _EXPECT = {
     "signal": ("SIGNAL", "L|LL|LU|U|UU|USU|H|HB|B|A"),

@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING, Any, Protocol
 
 if TYPE_CHECKING:
     from liansuo.interlocking.io import Event, Result
-    from liansuo.interlocking.table import InterlockingTable
+    from liansuo.interlocking.table.build import InterlockingTable
     from liansuo.rules import RuleSet
     from liansuo.simulation.language import Language
     from liansuo.simulation.sim import Simulation

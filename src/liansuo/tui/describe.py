@@ -7,10 +7,10 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from .layout import Ref
+from liansuo.tui.layout import Ref
 
 if TYPE_CHECKING:
-    from .consolesim import ConsoleSim
+    from liansuo.tui.consolesim import ConsoleSim
 
 SIGNAL_KIND = {"home": "进站信号机 home signal", "starting": "出站信号机 starting signal",
                "route": "进路信号机 route signal", "shunting": "调车信号机 shunting signal",

@@ -20,12 +20,12 @@ from textual.message import Message
 from textual.scroll_view import ScrollView
 from textual.strip import Strip
 
-from .guard import Guarded
-from .layout import MAX_ZOOM, Layout, Ref, build_layout
-from .paint import S_CURSOR, Frame, add_overlays, glyph, read_frame
+from liansuo.tui.guard import Guarded
+from liansuo.tui.layout import MAX_ZOOM, Layout, Ref, build_layout
+from liansuo.tui.paint import S_CURSOR, Frame, add_overlays, glyph, read_frame
 
 if TYPE_CHECKING:
-    from .consolesim import ConsoleSim
+    from liansuo.tui.consolesim import ConsoleSim
 
 CLICKABLE = ("button", "turnout", "signal", "section", "platform", "block")
 

@@ -20,11 +20,10 @@ from textual.geometry import Offset, Region, Size
 from textual.screen import ModalScreen
 from textual.widgets import Button, Input, Label, Static
 
-from liansuo.stations.printable import printable
-
-from .guard import Guarded, on_top
-from .operate import MENUS, MODES
-from .paint import (
+from liansuo.kit.printable import printable
+from liansuo.tui.guard import Guarded, on_top
+from liansuo.tui.operate import MENUS, MODES
+from liansuo.tui.paint import (
     BAND_COLOUR,
     LAMP_COLOUR,
     S_BUTTON,
@@ -40,7 +39,7 @@ from .paint import (
     S_TRAIN,
     S_TURNOUT,
 )
-from .plain import plain
+from liansuo.tui.plain import plain
 
 DIALOG_CSS = """
 {name} {{ align: center middle; background: rgba(0, 0, 0, 0.55); }}

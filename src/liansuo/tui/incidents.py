@@ -7,9 +7,8 @@ from __future__ import annotations
 import traceback
 from dataclasses import dataclass
 
-from liansuo.stations.printable import printable, printable_block
-
-from .panels import AlarmLine
+from liansuo.kit.printable import printable, printable_block
+from liansuo.tui.panels import AlarmLine
 
 # How many different incidents a session keeps (the same error again only counts up): enough for any report, and a
 # handler failing on every redraw cannot grow the list without end.

@@ -17,14 +17,13 @@ from textual.message import Message
 from textual.widgets import Button, Input, Label, Select, Static
 
 from liansuo.circuits.faults import KINDS
-
-from .completion import fault_targets
-from .guard import Guarded
-from .layout import Ref
-from .plain import plain
+from liansuo.tui.completion import fault_targets
+from liansuo.tui.guard import Guarded
+from liansuo.tui.layout import Ref
+from liansuo.tui.plain import plain
 
 if TYPE_CHECKING:
-    from .consolesim import ConsoleSim
+    from liansuo.tui.consolesim import ConsoleSim
 
 
 class InstructorPanel(Guarded, VerticalScroll):

@@ -19,8 +19,7 @@ from dataclasses import dataclass, field
 
 from liansuo.stations.schema import Direction, SectionRole
 from liansuo.stations.station import Station
-
-from .rows import drawn_at, node_rows, track_rows
+from liansuo.tui.rows import drawn_at, node_rows, track_rows
 
 BAND = "━"
 DIAG_DOWN = "╲"  # going right and down the screen

@@ -16,13 +16,11 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, cast
 
 from liansuo.simulation import Result
-
-from .panels import clock_text
+from liansuo.tui.panels import clock_text
 
 if TYPE_CHECKING:
     from liansuo.simulation.sim import Simulation
-
-    from .consolesim import ConsoleSim
+    from liansuo.tui.consolesim import ConsoleSim
 
 # Wall-clock seconds of simulation in one slice. The clock ticks every 0.125 s (tui/app.py, TICK_S), so a long run
 # takes less than half of each tick and keys, clicks and redraws keep the rest.

@@ -17,10 +17,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Literal
 
-from .layout import Ref
+from liansuo.tui.layout import Ref
 
 if TYPE_CHECKING:
-    from .consolesim import ConsoleSim
+    from liansuo.tui.consolesim import ConsoleSim
 
 
 @dataclass(frozen=True)

@@ -17,12 +17,11 @@ from typing import TYPE_CHECKING
 
 from rich.style import Style
 
-from liansuo.stations.printable import printable
-
-from .layout import Glyph, Layout, Ref
+from liansuo.kit.printable import printable
+from liansuo.tui.layout import Glyph, Layout, Ref
 
 if TYPE_CHECKING:
-    from .consolesim import ConsoleSim
+    from liansuo.tui.consolesim import ConsoleSim
 
 # by the lamp's colour (the rule set gives each lamp's colour and their order on the mast)
 LAMP_COLOUR = {"green": "#00e050", "yellow": "#ffd700", "red": "#ff2020", "white": "#f4f4ff", "blue": "#2f6bff"}

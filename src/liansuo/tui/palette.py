@@ -16,7 +16,7 @@ from textual import work
 from textual.await_complete import AwaitComplete
 from textual.command import CommandPalette
 
-from .guard import Guarded, on_top
+from liansuo.tui.guard import Guarded, on_top
 
 _SEARCH: Callable[[CommandPalette, str], Coroutine[Any, Any, None]] = cast(
     "Callable[[CommandPalette, str], Coroutine[Any, Any, None]]",

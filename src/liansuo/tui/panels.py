@@ -18,16 +18,15 @@ from textual.suggester import Suggester
 from textual.widget import Widget
 from textual.widgets import Input, RichLog, Static
 
-from liansuo.simulation.snapshot import EventCursor
-from liansuo.stations.printable import printable
-
-from .completion import candidates, complete, example_route
-from .guard import Guarded
-from .layout import Ref
-from .operate import MODES
+from liansuo.classroom.snapshot import EventCursor
+from liansuo.kit.printable import printable
+from liansuo.tui.completion import candidates, complete, example_route
+from liansuo.tui.guard import Guarded
+from liansuo.tui.layout import Ref
+from liansuo.tui.operate import MODES
 
 if TYPE_CHECKING:
-    from .consolesim import ConsoleSim
+    from liansuo.tui.consolesim import ConsoleSim
 
 
 def waiting_text(sim: ConsoleSim, focus: Ref | None) -> str:

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from rich.text import Text
 
-from liansuo.stations.printable import printable_block
+from liansuo.kit.printable import printable_block
 
 
 def plain(text: str, style: str = "") -> Text:

@@ -14,16 +14,15 @@ from typing import ClassVar
 from rich.text import Text
 from textual.binding import Binding, BindingType
 
+from liansuo.kit.printable import printable
 from liansuo.simulation import Result
-from liansuo.simulation.recordingfile import Recording
-from liansuo.simulation.replayer import Replayer
+from liansuo.simulation.recording.file import Recording
+from liansuo.simulation.recording.replayer import Replayer
 from liansuo.simulation.timeparse import parse_duration
-from liansuo.stations.printable import printable
 from liansuo.stations.station import Station
-
-from .app import ConsoleApp
-from .layout import Ref
-from .panels import clock_text
+from liansuo.tui.app import ConsoleApp
+from liansuo.tui.layout import Ref
+from liansuo.tui.panels import clock_text
 
 
 class ReplayApp(ConsoleApp):

@@ -22,10 +22,10 @@ from textual.command import CommandPalette
 from textual.screen import Screen
 from textual.theme import ThemeProvider
 
-from .dialogs import QuitScreen
-from .guard import Guarded
-from .incidents import Incident, Incidents
-from .palette import ConsolePalette
+from liansuo.tui.dialogs import QuitScreen
+from liansuo.tui.guard import Guarded
+from liansuo.tui.incidents import Incident, Incidents
+from liansuo.tui.palette import ConsolePalette
 
 
 class ConsoleScreen(Guarded, Screen[None]):

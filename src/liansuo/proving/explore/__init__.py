@@ -8,7 +8,7 @@ judged by the independent safety oracle at every cycle (docs/explore.md).
 - :mod:`.report` turns what it found into shortest reproducer scripts and a report; :mod:`.cli` is the command.
 """
 
-from .actions import Bounds
-from .search import Expander, Outcome, expand_here, search
+from liansuo.proving.explore.actions import Bounds
+from liansuo.proving.explore.search import Expander, Outcome, expand_here, search
 
 __all__ = ["Bounds", "Expander", "Outcome", "expand_here", "search"]

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 from liansuo.interlocking.core import Core
 from liansuo.interlocking.locks import Hold
-from liansuo.interlocking.route import Route
+from liansuo.interlocking.table.route import Route
 from liansuo.simulation.sim import Simulation
 from liansuo.stations.schema import EndKind, LinkKind, SignalKind
 from liansuo.stations.station import Station

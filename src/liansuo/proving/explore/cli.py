@@ -11,18 +11,17 @@ from collections.abc import Callable, Iterator
 from contextlib import ExitStack, contextmanager
 from pathlib import Path
 
+from liansuo.kit.arguments import count, positive_int
+from liansuo.kit.exitcodes import Exit, bad_input, refuse
+from liansuo.kit.fit import fit_all
+from liansuo.kit.jsonreport import print_report
+from liansuo.kit.source import StationError
+from liansuo.proving.explore.actions import Bounds
+from liansuo.proving.explore.report import as_dict, as_text
+from liansuo.proving.explore.search import Expander, expand_here, expand_on, search
+from liansuo.proving.spread import SpreadError, client
 from liansuo.rules import load_rules
-from liansuo.stations.arguments import count, positive_int
-from liansuo.stations.exitcodes import Exit, bad_input, refuse
-from liansuo.stations.fit import fit_all
-from liansuo.stations.jsonreport import print_report
 from liansuo.stations.loader import load
-from liansuo.stations.source import StationError
-
-from ..spread import SpreadError, client
-from .actions import Bounds
-from .report import as_dict, as_text
-from .search import Expander, expand_here, expand_on, search
 
 Add = Callable[..., argparse.ArgumentParser]
 

@@ -27,10 +27,9 @@ from typing import Any
 
 from liansuo.interlocking.locks import Lock
 from liansuo.interlocking.state import RouteStage
+from liansuo.proving.judge.judge import TOLERANCE_S
+from liansuo.proving.oracle.watch import Watch
 from liansuo.simulation.sim import Simulation
-
-from ..judge.judge import TOLERANCE_S
-from ..oracle.watch import Watch
 
 
 def state_key(sim: Simulation, watch: Watch) -> bytes:

@@ -9,8 +9,8 @@ from typing import Any
 
 import yaml
 
-from .actions import Bounds
-from .search import Found, Outcome
+from liansuo.proving.explore.actions import Bounds
+from liansuo.proving.explore.search import Found, Outcome
 
 # what the explored model leaves out or bounds, said with every report (docs/explore.md)
 ABSTRACTIONS = (

@@ -22,15 +22,14 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from liansuo.interlocking.state import RouteStage
+from liansuo.proving.explore.actions import ADVANCE, GLOBAL, Action, Bounds, Model
+from liansuo.proving.explore.key import state_key
+from liansuo.proving.explore.snapshot import Shared, restore, take
+from liansuo.proving.oracle.watch import Violation, Watch
+from liansuo.proving.spread import RETRIES
 from liansuo.rules import RuleSet
 from liansuo.simulation.sim import Simulation
 from liansuo.stations.station import Station
-
-from ..oracle.watch import Violation, Watch
-from ..spread import RETRIES
-from .actions import ADVANCE, GLOBAL, Action, Bounds, Model
-from .key import state_key
-from .snapshot import Shared, restore, take
 
 ADVANCE_CAP_S = 400.0  # time runs on at most this long at once (longer than every timer of the rule set)
 ANSWER_CYCLES = 12  # after a command or an event, the interlocking answers within this many cycles (a few, in fact)

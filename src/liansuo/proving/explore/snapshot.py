@@ -13,10 +13,9 @@ import io
 import pickle
 from typing import Any
 
+from liansuo.proving.oracle.watch import Watch
 from liansuo.simulation.sim import Simulation
 from liansuo.simulation.view import InterlockingView
-
-from ..oracle.watch import Watch
 
 _PARTS = ("interlocking", "field", "wiring", "neighbours", "t", "parked", "alarms", "sealed")
 

@@ -27,16 +27,15 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from liansuo.proving.judge.rules import approach_extent, fault_release_delay, overlap_time, release_delay
+from liansuo.proving.oracle.authority import Tracer
+from liansuo.proving.oracle.check import Finding
+from liansuo.proving.oracle.gradient import beyond, steep_homes
+from liansuo.proving.oracle.lamps import LampReader
+from liansuo.proving.oracle.view import FieldView
 from liansuo.rules import RuleSet
 from liansuo.stations.schema import SectionRole, SignalKind
 from liansuo.stations.station import Station
-
-from ..oracle.authority import Tracer
-from ..oracle.check import Finding
-from ..oracle.gradient import beyond, steep_homes
-from ..oracle.lamps import LampReader
-from ..oracle.view import FieldView
-from .rules import approach_extent, fault_release_delay, overlap_time, release_delay
 
 TOLERANCE_S = 1.0  # what the judge lets pass of a timer: a cycle to see, a cycle to act, a little more
 _SETS = ("route", "shunt", "guide")

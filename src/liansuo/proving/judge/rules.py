@@ -5,11 +5,10 @@ derived table says (TB/T 3027-2015, TB 10007-2017, 技规 TG/01-2014; docs/rules
 
 from __future__ import annotations
 
+from liansuo.proving.oracle.authority import Tracer
 from liansuo.rules import RuleSet
 from liansuo.stations.schema import Direction, LinkKind, SignalKind
 from liansuo.stations.station import Station
-
-from ..oracle.authority import Tracer
 
 
 def release_delay(station: Station, rules: RuleSet, signal: str, kind: str) -> float:

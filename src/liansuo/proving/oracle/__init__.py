@@ -6,8 +6,8 @@ the safety properties. It imports nothing of the interlocking but its rule data:
 engine, not the aspect rules (``tests/test_oracle.py`` holds it to that).
 """
 
-from .authority import Authority, Tracer
-from .check import Finding, Oracle
-from .watch import SimulationView, Violation, Watch
+from liansuo.proving.oracle.authority import Authority, Tracer
+from liansuo.proving.oracle.check import Finding, Oracle
+from liansuo.proving.oracle.watch import SimulationView, Violation, Watch
 
 __all__ = ["Authority", "Finding", "Oracle", "SimulationView", "Tracer", "Violation", "Watch"]

@@ -23,11 +23,10 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Literal
 
+from liansuo.proving.oracle.gradient import Overlap, beyond, steep_homes
 from liansuo.rules import RuleSet
 from liansuo.stations.schema import Direction, SectionRole, SignalKind
 from liansuo.stations.station import Station
-
-from .gradient import Overlap, beyond, steep_homes
 
 Kind = Literal["train", "shunt"]
 Lies = Callable[[str], "str | None"]  # turnout -> where its switch rails lie ('normal', 'reverse' or None)

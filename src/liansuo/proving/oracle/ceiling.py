@@ -26,13 +26,12 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from liansuo.proving.oracle.authority import Authority
+from liansuo.proving.oracle.lamps import DARK, UNDEFINED
+from liansuo.proving.oracle.view import FieldView
 from liansuo.rules import Aspects, RuleSet
 from liansuo.stations.schema import SignalKind
 from liansuo.stations.station import Station
-
-from .authority import Authority
-from .lamps import DARK, UNDEFINED
-from .view import FieldView
 
 
 @dataclass(frozen=True)

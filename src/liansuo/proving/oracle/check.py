@@ -20,16 +20,15 @@ from __future__ import annotations
 from collections.abc import Iterable
 from dataclasses import dataclass
 
+from liansuo.proving.oracle.authority import Authority, Tracer
+from liansuo.proving.oracle.ceiling import Ceiling, permits
+from liansuo.proving.oracle.flank import Demand, Flank, clearance_m
+from liansuo.proving.oracle.lamps import UNDEFINED, LampReader
+from liansuo.proving.oracle.meet import Extent, head_on, shared
+from liansuo.proving.oracle.view import FieldView
 from liansuo.rules import RuleSet
 from liansuo.stations.schema import Direction, SectionRole, SignalKind
 from liansuo.stations.station import Station
-
-from .authority import Authority, Tracer
-from .ceiling import Ceiling, permits
-from .flank import Demand, Flank, clearance_m
-from .lamps import UNDEFINED, LampReader
-from .meet import Extent, head_on, shared
-from .view import FieldView
 
 TURNOUT_AREA_M = 40.0  # wheelsets this close to a turnout's point stand on its switch panel
 

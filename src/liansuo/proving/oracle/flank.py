@@ -20,11 +20,10 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
+from liansuo.proving.oracle.authority import other
 from liansuo.rules import RuleSet
 from liansuo.stations.schema import Direction, SectionRole
 from liansuo.stations.station import Station
-
-from .authority import other
 
 _WALKABLE = frozenset({SectionRole.throat})
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 
-from .authority import Authority
+from liansuo.proving.oracle.authority import Authority
 
 
 @dataclass

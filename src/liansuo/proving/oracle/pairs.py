@@ -16,12 +16,11 @@ from __future__ import annotations
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
 
+from liansuo.proving.oracle.authority import Authority, Kind, Tracer, other
+from liansuo.proving.oracle.flank import Demand, Flank, clearance_m
+from liansuo.proving.oracle.meet import Extent, head_on, shared
 from liansuo.rules import RuleSet
 from liansuo.stations.station import Station
-
-from .authority import Authority, Kind, Tracer, other
-from .flank import Demand, Flank, clearance_m
-from .meet import Extent, head_on, shared
 
 
 @dataclass(frozen=True)

@@ -12,10 +12,9 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
+from liansuo.proving.oracle.check import Finding, Oracle
 from liansuo.rules import RuleSet
 from liansuo.simulation.language import split_words
-
-from .check import Finding, Oracle
 
 if TYPE_CHECKING:
     from liansuo.interlocking.io import Result
@@ -151,7 +150,9 @@ class Watch:
                  reaction: int = 2, judge: bool = True) -> None:
         """``judge``: the reference judge of commands and releases (:mod:`proving.judge`) watches beside the oracle,
         and its findings are reported as violations too."""
-        from ..judge import Judge  # the judge reads what the oracle's view reads, and the oracle's geometry
+        from liansuo.proving.judge import (
+            Judge,  # the judge reads what the oracle's view reads, and the oracle's geometry
+        )
 
         self.sim = sim
         self.oracle = Oracle(sim.station, rules or sim.rules, cycle_s=sim.cycle_s, reaction=reaction)

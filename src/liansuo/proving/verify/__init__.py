@@ -14,21 +14,20 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from liansuo.interlocking.table import InterlockingTable, Route
+from liansuo.interlocking.table.build import InterlockingTable, Route
+from liansuo.kit.fit import fit_all, plural
+from liansuo.proving.oracle.pairs import PaperOracle
+from liansuo.proving.progress import progress
+from liansuo.proving.verify.against import approach_extent, pair_conflicts, route_demands, spec
+from liansuo.proving.verify.apart import near_masks, table_reach
+from liansuo.proving.verify.data import check_station
+from liansuo.proving.verify.plan import Unit, UnitResult, again, merge, plan
+from liansuo.proving.verify.probe import Failure, FirstFailure
+from liansuo.proving.verify.routecheck import RouteResult
+from liansuo.proving.verify.units import Bench, frozen, run_here, spread_units
 from liansuo.rules import RuleSet, load_rules
-from liansuo.stations.fit import fit_all, plural
 from liansuo.stations.loader import load
 from liansuo.stations.station import Station
-
-from ..oracle.pairs import PaperOracle
-from ..progress import progress
-from .against import approach_extent, pair_conflicts, route_demands, spec
-from .apart import near_masks, table_reach
-from .data import check_station
-from .plan import Unit, UnitResult, again, merge, plan
-from .probe import Failure, FirstFailure
-from .routecheck import RouteResult
-from .units import Bench, frozen, run_here, spread_units
 
 
 @dataclass

@@ -13,12 +13,11 @@ does.
 
 from __future__ import annotations
 
-from liansuo.interlocking.table import Route
+from liansuo.interlocking.table.build import Route
+from liansuo.proving.judge.rules import approach_extent as rules_extent
+from liansuo.proving.oracle.pairs import PaperOracle, RouteSpec
+from liansuo.proving.verify.probe import Context
 from liansuo.stations.schema import SectionRole
-
-from ..judge.rules import approach_extent as rules_extent
-from ..oracle.pairs import PaperOracle, RouteSpec
-from .probe import Context
 
 _LINE = (SectionRole.approach, SectionRole.departure, SectionRole.block)
 

@@ -22,7 +22,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
 
-from liansuo.interlocking.table import Route
+from liansuo.interlocking.table.build import Route
 from liansuo.stations.station import Station
 
 

@@ -6,19 +6,17 @@ from __future__ import annotations
 import argparse
 from collections.abc import Callable
 
-from liansuo.stations.arguments import count
-from liansuo.stations.exitcodes import Exit, bad_input, refuse
-from liansuo.stations.jsonreport import print_report
-
-from ..spread import SpreadError
+from liansuo.kit.arguments import count
+from liansuo.kit.exitcodes import Exit, bad_input, refuse
+from liansuo.kit.jsonreport import print_report
+from liansuo.proving.spread import SpreadError
 
 Add = Callable[..., argparse.ArgumentParser]
 
 
 def cmd_verify(args: argparse.Namespace) -> int:
-    from liansuo.stations.source import StationError
-
-    from . import report_text, verify_station
+    from liansuo.kit.source import StationError
+    from liansuo.proving.verify import report_text, verify_station
 
     try:
         rep = verify_station(args.station, routes=args.route, pairs=not args.no_pairs, strict=args.strict,

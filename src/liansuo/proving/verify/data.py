@@ -11,9 +11,8 @@ against the oracle in :mod:`.against`.
 
 from __future__ import annotations
 
+from liansuo.proving.verify.probe import Context, Failure
 from liansuo.stations.rules import min_coded_length
-
-from .probe import Context, Failure
 
 _DEAD_ZONE_WORDS = ("dead zone", "staggered")
 

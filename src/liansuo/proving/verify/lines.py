@@ -13,10 +13,9 @@ throat, and those bordering it), not from the interlocking; the oracle watches e
 
 from __future__ import annotations
 
-from liansuo.interlocking.table import Route
+from liansuo.interlocking.table.build import Route
+from liansuo.proving.verify.probe import Context, Probe, against_running, open_route, prepare, route_line
 from liansuo.stations.schema import LinkKind, SignalKind
-
-from .probe import Context, Probe, against_running, open_route, prepare, route_line
 
 _INNER = ("throat", "spur")
 

@@ -12,10 +12,9 @@ replayed on a fresh simulation and its script shows just the two routes.
 
 from __future__ import annotations
 
-from liansuo.interlocking.table import Route
+from liansuo.interlocking.table.build import Route
+from liansuo.proving.verify.probe import Context, Probe, open_route, prepare, route_line
 from liansuo.stations.schema import TurnoutPosition
-
-from .probe import Context, Probe, open_route, prepare, route_line
 
 SETTLE_S = 30.0
 MOVE_S = 8.0  # a turnout move with its indication, allowed per round of moves the interlocking drives at once

@@ -23,9 +23,8 @@ import heapq
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
 
-from liansuo.interlocking.table import InterlockingTable, Route
-
-from .probe import Failure
+from liansuo.interlocking.table.build import InterlockingTable, Route
+from liansuo.proving.verify.probe import Failure
 
 MAX_BATCH = 40  # routes set together at most: their turnout moves queue (a few at a time), so time grows with it
 CHAIN = 32  # batches one after the other on one simulation (each cancelled before the next is set)

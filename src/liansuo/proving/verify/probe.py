@@ -13,12 +13,11 @@ from dataclasses import dataclass, field
 
 from liansuo.interlocking.aspects import is_open, stop_aspect
 from liansuo.interlocking.io import Result
-from liansuo.interlocking.table import InterlockingTable, Route
+from liansuo.interlocking.table.build import InterlockingTable, Route
+from liansuo.proving.oracle import Watch
 from liansuo.rules import RuleSet
 from liansuo.simulation.sim import Simulation
 from liansuo.stations.station import Station
-
-from ..oracle import Watch
 
 REST_S = 2.0  # how long the turnouts must have been at rest before a wait for "nothing happens" ends
 

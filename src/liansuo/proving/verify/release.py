@@ -7,13 +7,21 @@ from __future__ import annotations
 from functools import partial
 
 from liansuo.interlocking.aspects import is_open
-from liansuo.interlocking.table import Route
+from liansuo.interlocking.table.build import Route
+from liansuo.proving.judge.rules import fault_release_delay, overlap_time, release_delay
+from liansuo.proving.verify.lines import reach
+from liansuo.proving.verify.probe import (
+    Context,
+    Failure,
+    Probe,
+    against_running,
+    open_route,
+    other,
+    prepare,
+    route_line,
+)
+from liansuo.proving.verify.routecheck import RouteCheck
 from liansuo.stations.schema import Link, SignalKind
-
-from ..judge.rules import fault_release_delay, overlap_time, release_delay
-from .lines import reach
-from .probe import Context, Failure, Probe, against_running, open_route, other, prepare, route_line
-from .routecheck import RouteCheck
 
 
 class ReleaseChecks:

@@ -12,9 +12,8 @@ from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import TypeVar
 
-from liansuo.interlocking.table import Route
-
-from .probe import Context, Probe, open_route
+from liansuo.interlocking.table.build import Route
+from liansuo.proving.verify.probe import Context, Probe, open_route
 
 T = TypeVar("T")
 

@@ -8,12 +8,11 @@ Each check runs on a fresh simulation (a :class:`~.probe.Probe`) and is recorded
 
 from __future__ import annotations
 
+from liansuo.proving.oracle.authority import Tracer
+from liansuo.proving.verify.probe import Probe, against_running, other, prepare, route_line, turnout_groups
+from liansuo.proving.verify.release import ReleaseChecks
+from liansuo.proving.verify.routecheck import RouteCheck, RouteResult
 from liansuo.stations.schema import SectionRole
-
-from ..oracle.authority import Tracer
-from .probe import Probe, against_running, other, prepare, route_line, turnout_groups
-from .release import ReleaseChecks
-from .routecheck import RouteCheck, RouteResult
 
 _LINE = (SectionRole.approach, SectionRole.departure, SectionRole.block)
 SETTLE_S = 20.0  # long enough for any turnout move (the slowest machine 6.6 s, two batches) and a 64D acceptance

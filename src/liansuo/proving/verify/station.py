@@ -3,12 +3,11 @@ lamp transfer (红灯转移) to the signals in rear of every signal that has a r
 
 from __future__ import annotations
 
-from liansuo.interlocking.table import Route
+from liansuo.interlocking.table.build import Route
+from liansuo.proving.oracle.authority import Tracer
+from liansuo.proving.verify.lines import shows_guide
+from liansuo.proving.verify.probe import Context, Probe, route_line
 from liansuo.stations.schema import SignalKind
-
-from ..oracle.authority import Tracer
-from .lines import shows_guide
-from .probe import Context, Probe, route_line
 
 _STATION = ("throat", "station_track", "spur")
 

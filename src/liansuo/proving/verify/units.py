@@ -12,19 +12,18 @@ from collections.abc import Callable, Iterable, Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
 
-from liansuo.interlocking.table import InterlockingTable, build_table
+from liansuo.interlocking.table.build import InterlockingTable, build_table
+from liansuo.proving.progress import Advance
+from liansuo.proving.spread import deal, fan_out
+from liansuo.proving.verify.lines import guide_area, line_direction
+from liansuo.proving.verify.pairs import PairTest
+from liansuo.proving.verify.plan import Unit, UnitResult
+from liansuo.proving.verify.probe import Context, FirstFailure
+from liansuo.proving.verify.release import throat_checks
+from liansuo.proving.verify.routes import RouteTest
+from liansuo.proving.verify.station import power_up, queued_move, red_lamp_transfer
 from liansuo.rules import RuleSet
 from liansuo.stations.station import Station
-
-from ..progress import Advance
-from ..spread import deal, fan_out
-from .lines import guide_area, line_direction
-from .pairs import PairTest
-from .plan import Unit, UnitResult
-from .probe import Context, FirstFailure
-from .release import throat_checks
-from .routes import RouteTest
-from .station import power_up, queued_move, red_lamp_transfer
 
 
 @dataclass

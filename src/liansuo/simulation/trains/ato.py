@@ -9,7 +9,7 @@ starting signal (which checks the same) is open.
 
 from __future__ import annotations
 
-from .lineside import Lineside
+from liansuo.simulation.trains.lineside import Lineside
 
 
 def platform_doors(sim: Lineside) -> None:

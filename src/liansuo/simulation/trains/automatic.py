@@ -14,16 +14,15 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from liansuo.interlocking.io import Result
-
-from .autoshunt import (
+from liansuo.simulation.trains.autoshunt import (
     ONE_STOP_WINDOW_M,
     ShuntingInputs,
     driving_conditions,
     entry_conditions,
     permitted_speed_kmh,
 )
-from .fleet import Train
-from .lineside import Lineside
+from liansuo.simulation.trains.fleet import Train
+from liansuo.simulation.trains.lineside import Lineside
 
 ONE_STOP_MARGIN_M = 1.0  # the front comes to a stand this far short of a one-stop point
 

@@ -37,13 +37,12 @@ from liansuo.circuits.cabcurrent import CabCurrents
 from liansuo.circuits.field import Field
 from liansuo.circuits.leakage import LongDeadZone
 from liansuo.circuits.trackcircuits import SectionCircuit
-from liansuo.circuits.zpw2000a import End, ZpwCircuit
+from liansuo.circuits.zpw.model import End, ZpwCircuit
+from liansuo.simulation.trains.consist import Consist
+from liansuo.simulation.trains.movement import Position, Track
 from liansuo.stations.schema import Direction
 from liansuo.stations.station import Station
 from liansuo.stations.topology import Move
-
-from .consist import Consist
-from .movement import Position, Track
 
 CAB_STATES = ("none", "code", "lost", "wrong-carrier")
 ATP = "atp"  # the emergency-stop source of the ATP's brake

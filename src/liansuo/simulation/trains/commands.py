@@ -7,15 +7,14 @@ from collections.abc import Callable
 from typing import Protocol
 
 from liansuo.interlocking.io import Result
-from liansuo.interlocking.table import InterlockingTable
+from liansuo.interlocking.table.build import InterlockingTable
+from liansuo.simulation.language import Command
+from liansuo.simulation.timeparse import parse_duration
+from liansuo.simulation.trains.consist import make_consist
+from liansuo.simulation.trains.fleet import MODES, Fleet, Train
 from liansuo.stations import limits
 from liansuo.stations.schema import Direction
 from liansuo.stations.station import Station
-
-from ..language import Command
-from ..timeparse import parse_duration
-from .consist import make_consist
-from .fleet import MODES, Fleet, Train
 
 
 class Yard(Protocol):

@@ -14,10 +14,9 @@ from collections.abc import Mapping
 from math import sqrt
 
 from liansuo.rules import RuleSet
+from liansuo.simulation.trains.movement import OUTSIDE, Position, Track
 from liansuo.stations.schema import Direction, EndKind, Signal, SignalKind
 from liansuo.stations.station import Station
-
-from .movement import OUTSIDE, Position, Track
 
 
 def stopping_speed(distance_m: float, brake_ms2: float) -> float:

@@ -12,7 +12,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Protocol
 
-from .consist import Consist
+from liansuo.simulation.trains.consist import Consist
 
 
 class MotionEngine(Protocol):

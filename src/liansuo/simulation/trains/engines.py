@@ -4,12 +4,11 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+from liansuo.simulation.trains.engine import KinematicEngine, MotionEngine
 from liansuo.stations.station import Station
 
-from .engine import KinematicEngine, MotionEngine
-
 if TYPE_CHECKING:
-    from .fleet import Fleet
+    from liansuo.simulation.trains.fleet import Fleet
 
 ENGINES = ("kinematic", "sumo")
 
@@ -23,7 +22,7 @@ def make_engine(engine: str | MotionEngine, station: Station, cycle_s: float) ->
     if engine == "kinematic":
         return KinematicEngine()
     if engine == "sumo":
-        from .sumo import SumoEngine
+        from liansuo.simulation.trains.sumo import SumoEngine
 
         return SumoEngine(station, step_s=cycle_s)
     raise ValueError(f"unknown train engine '{engine}': choose {' or '.join(ENGINES)}")

@@ -17,19 +17,18 @@ from liansuo.circuits.field import Field
 from liansuo.circuits.leakage import LongDeadZone, long_dead_zones
 from liansuo.circuits.railgeometry import Axle
 from liansuo.rules import RuleSet, load_rules
+from liansuo.simulation.trains.autoshunt import EmergencyStops
+from liansuo.simulation.trains.cabsignal import ATP, CabReader, CabReading, CabSignal
+from liansuo.simulation.trains.consist import Consist
+from liansuo.simulation.trains.drivers import Lookout, aim, stopping_speed
+from liansuo.simulation.trains.engine import KinematicEngine, MotionEngine
+from liansuo.simulation.trains.movement import OUTSIDE, Notify, Position, Track
+from liansuo.simulation.trains.odometerfeed import OdometerFeed
+from liansuo.simulation.trains.traction import leaking_sections
+from liansuo.simulation.trains.wheelsets import TrainWheelsets, wheelsets_now
 from liansuo.stations.schema import Direction, Marker
 from liansuo.stations.station import Station
 from liansuo.stations.topology import Move
-
-from .autoshunt import EmergencyStops
-from .cabsignal import ATP, CabReader, CabReading, CabSignal
-from .consist import Consist
-from .drivers import Lookout, aim, stopping_speed
-from .engine import KinematicEngine, MotionEngine
-from .movement import OUTSIDE, Notify, Position, Track
-from .odometerfeed import OdometerFeed
-from .traction import leaking_sections
-from .wheelsets import TrainWheelsets, wheelsets_now
 
 MODES = ("manual", "signal", "auto")
 WHEEL_OHM = Axle._field_defaults["ohm"]  # a clean wheelset

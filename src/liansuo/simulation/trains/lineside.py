@@ -9,12 +9,11 @@ from typing import Protocol
 
 from liansuo.circuits.railgeometry import Axle
 from liansuo.interlocking.io import Result
-from liansuo.interlocking.table import InterlockingTable
+from liansuo.interlocking.table.build import InterlockingTable
 from liansuo.rules import RuleSet
+from liansuo.simulation.trains.fleet import Fleet
+from liansuo.simulation.view import InterlockingView
 from liansuo.stations.station import Station
-
-from ..view import InterlockingView
-from .fleet import Fleet
 
 
 class Lineside(Protocol):

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from typing import cast
 
-from .odometry import Correction, Odometer, State
+from liansuo.simulation.trains.odometry import Correction, Odometer, State
 
 MAX_PENDING = 4096  # steps noted before they are worked out anyway: about 17 simulated minutes at 0.25 s a cycle
 

@@ -29,17 +29,16 @@ from multiprocessing.process import BaseProcess
 from typing import TYPE_CHECKING, Any
 
 from liansuo.circuits.machines import SwitchMachine
+from liansuo.simulation.trains.consist import Consist
+from liansuo.simulation.trains.engine import KinematicEngine
+from liansuo.simulation.trains.movement import OUTSIDE, Position
+from liansuo.simulation.trains.sumo_export import SumoNetwork, SumoUnavailable, build_network, link_state, sumo_home
+from liansuo.simulation.trains.sumo_worker import main as worker_main
 from liansuo.stations.station import Station
 from liansuo.stations.topology import Move
 
-from .consist import Consist
-from .engine import KinematicEngine
-from .movement import OUTSIDE, Position
-from .sumo_export import SumoNetwork, SumoUnavailable, build_network, link_state, sumo_home
-from .sumo_worker import main as worker_main
-
 if TYPE_CHECKING:
-    from .fleet import Fleet
+    from liansuo.simulation.trains.fleet import Fleet
 
 
 class SumoEngineError(RuntimeError):

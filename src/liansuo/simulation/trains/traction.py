@@ -14,9 +14,8 @@ from collections.abc import Iterable
 from typing import Protocol
 
 from liansuo.circuits.leakage import LongDeadZone
-
-from .consist import Consist
-from .movement import Position, Track
+from liansuo.simulation.trains.consist import Consist
+from liansuo.simulation.trains.movement import Position, Track
 
 
 class Drawing(Protocol):

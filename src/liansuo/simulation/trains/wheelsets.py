@@ -16,10 +16,9 @@ from itertools import pairwise
 
 from liansuo.circuits.railgeometry import RailGeometry
 from liansuo.circuits.shunts import Shunt
+from liansuo.simulation.trains.movement import OUTSIDE_LENGTH, Position, Track
 from liansuo.stations.schema import Direction
 from liansuo.stations.topology import Move
-
-from .movement import OUTSIDE_LENGTH, Position, Track
 
 EDGE_M = 1e-6  # a wheelset this close to an edge may be on either side: far above the rounding of positions
 

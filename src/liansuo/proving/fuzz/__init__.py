@@ -1,0 +1,2 @@
+"""Fuzzing (docs/robustness.md): the runner, liansuo fuzz, and every kind: station files, command lines, recordings,
+console sessions."""

@@ -1,0 +1,1 @@
+"""Random operation of a station against the safety oracle: liansuo soak."""
