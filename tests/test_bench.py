@@ -82,6 +82,24 @@ def test_cli_bench_prints_json(monkeypatch: pytest.MonkeyPatch, capsys: pytest.C
     assert "targets:" in capsys.readouterr().out
 
 
+def test_each_run_asked_for_is_appended_to_the_history(monkeypatch: pytest.MonkeyPatch, tmp_path: Path,
+                                                       capsys: pytest.CaptureFixture[str]) -> None:
+    monkeypatch.setattr(bench, "run_bench",
+                        lambda quick=False, scale=None, show_progress=None: run_bench(Sizes.tiny(), quick=quick))
+    history = tmp_path / "history.jsonl"
+    for _ in range(2):
+        assert main(["bench", "--quick", "--history", str(history)]) == 0
+        printed = json.loads(capsys.readouterr().out)
+    lines = [json.loads(line) for line in history.read_text(encoding="utf-8").splitlines()]
+    assert len(lines) == 2
+    assert lines[1]["date"] >= lines[0]["date"] and lines[1]["date"].endswith("+00:00")
+    assert lines[1]["commit"] is None or lines[1]["commit"].rstrip("+").isalnum()  # None when installed
+    assert {k: v for k, v in lines[1].items() if k not in ("date", "commit")}.keys() == printed.keys()
+    assert lines[1]["results"]["jiaopei"]["routes"] == printed["results"]["jiaopei"]["routes"]
+    assert main(["bench", "--history", str(tmp_path)]) == 2  # a folder: refused before anything runs
+    assert "give --history a file name" in capsys.readouterr().err
+
+
 @pytest.mark.parametrize(("turnouts", "tracks"), [(0, 1), (6, 4), (20, 8), (61, 24)])
 def test_generated_hub_is_valid_and_exact(turnouts: int, tracks: int) -> None:
     station = load_text(generate_hub(turnouts, tracks), "<hub>")

@@ -6,9 +6,11 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 from liansuo.bench.busy import BUSY_ROUTES
+from liansuo.bench.history import append
 from liansuo.bench.machine import machine
 from liansuo.bench.scale import ScaleSizes, measure_scale
 from liansuo.bench.station import measure
@@ -17,6 +19,7 @@ from liansuo.bench.zpw import ZPW_TARGET_CONFIGS_PER_S, measure_zpw
 from liansuo.interlocking.table.build import build_table
 from liansuo.kit.fit import fit_all
 from liansuo.kit.jsonreport import print_report
+from liansuo.kit.jsonreport import report as jsonreport
 from liansuo.kit.native import native_modules
 from liansuo.proving.progress import Advance, progress
 from liansuo.stations.hubgen import generate_hub
@@ -190,13 +193,16 @@ def as_text(report: dict[str, Any]) -> str:
     return fit_all(lines)
 
 
-def main(quick: bool = False, fmt: str = "json", scale: bool = False, explore: bool = False) -> int:
+def main(quick: bool = False, fmt: str = "json", scale: bool = False, explore: bool = False,
+         history: Path | None = None) -> int:
     if explore:  # its own run: it takes the better part of an hour in full
         from liansuo.bench.explore import ExploreSizes, measure_explore
 
         figures = measure_explore(ExploreSizes.quick() if quick else ExploreSizes())
         report: dict[str, Any] = {"benchmark": "liansuo explore", "mode": "quick" if quick else "full",
                                   "machine": machine(), "explore": figures}
+        if history is not None:
+            append(history, jsonreport("bench", True, report))
         if fmt == "json":
             print_report("bench", True, report)
         else:
@@ -204,6 +210,8 @@ def main(quick: bool = False, fmt: str = "json", scale: bool = False, explore: b
         return 0
     sizes = (ScaleSizes.quick() if quick else ScaleSizes()) if scale else None
     report = run_bench(quick=quick, scale=sizes, show_progress=None)
+    if history is not None:
+        append(history, jsonreport("bench", True, report))
     if fmt == "json":
         print_report("bench", True, report)  # the figures are reported, never judged: always ok
     else:
