@@ -6,14 +6,8 @@ from __future__ import annotations
 import pytest
 
 from liansuo.simulation.trains.autoshunt import (
-    PRIORITY,
     SAFE_DISTANCE_M,
-    Action,
-    DepotMarker,
-    DrivingMode,
     EmergencyStops,
-    ModeArbiter,
-    OneStopPoints,
     ShuntingInputs,
     StopTarget,
     braking_speed_kmh,
@@ -21,8 +15,16 @@ from liansuo.simulation.trains.autoshunt import (
     driving_conditions,
     entry_conditions,
     entry_warnings,
-    next_stop,
     permitted_speed_kmh,
+)
+from liansuo.simulation.trains.research.shunting import (
+    PRIORITY,
+    DepotMarker,
+    DrivingMode,
+    ModeArbiter,
+    OneStopPoints,
+    ShuntAction,
+    next_stop,
     stop_target,
 )
 from liansuo.stations.loader import load
@@ -124,55 +126,55 @@ def test_entry_is_refused_while_an_entry_condition_is_unmet() -> None:
     arb = ModeArbiter()
     unmet = arb.engage(DrivingMode.auto_shunting, ShuntingInputs.all_clear(comms_ok=False))
     assert unmet and arb.mode is DrivingMode.manual
-    assert arb.decide(CLEAR).action is Action.manual
+    assert arb.decide(CLEAR).action is ShuntAction.manual
 
 
 def test_automatic_moves_only_when_every_condition_holds() -> None:
     arb = auto_arbiter()
-    assert arb.decide(CLEAR).action is Action.move
+    assert arb.decide(CLEAR).action is ShuntAction.move
     d = arb.decide(ShuntingInputs.all_clear(signal_ahead_open=False))
-    assert d.action is Action.brake and d.reasons == ("the signal ahead is not open",)
-    assert arb.decide(CLEAR, demand_move=False).action is Action.brake
+    assert d.action is ShuntAction.brake and d.reasons == ("the signal ahead is not open",)
+    assert arb.decide(CLEAR, demand_move=False).action is ShuntAction.brake
     assert arb.mode is DrivingMode.auto_shunting  # a missing condition brakes, it does not leave automatic mode
 
 
 def test_manual_driving_overrides_automatic_and_latches() -> None:
     arb = auto_arbiter()
     d = arb.decide(CLEAR, manual_input=True)
-    assert d.action is Action.manual and "driver took over" in d.reasons[0]
-    assert arb.decide(CLEAR).action is Action.manual  # stays manual until engaged again
+    assert d.action is ShuntAction.manual and "driver took over" in d.reasons[0]
+    assert arb.decide(CLEAR).action is ShuntAction.manual  # stays manual until engaged again
     assert arb.engage(DrivingMode.auto_shunting, CLEAR) == []
-    assert arb.decide(CLEAR).action is Action.move
+    assert arb.decide(CLEAR).action is ShuntAction.move
 
 
 def test_stopping_outranks_moving_even_manual_moving() -> None:
     arb = auto_arbiter()
     arb.stops.apply("system", "obstacle")
     d = arb.decide(ShuntingInputs.all_clear(speed_kmh=6.0), manual_input=True)
-    assert d.action is Action.emergency_brake and "automatic driving system" in d.reasons[0]
+    assert d.action is ShuntAction.emergency_brake and "automatic driving system" in d.reasons[0]
     arb.stops.release("system", by="system")
-    assert arb.decide(CLEAR).action is Action.manual  # the driver's input still latched manual mode
+    assert arb.decide(CLEAR).action is ShuntAction.manual  # the driver's input still latched manual mode
 
 
 def test_an_emergency_stop_at_a_secured_stand_only_watches_the_speed() -> None:
     arb = auto_arbiter()
     arb.stops.apply("remote")
-    assert arb.decide(CLEAR, secured=True).action is Action.monitor
-    assert arb.decide(ShuntingInputs.all_clear(speed_kmh=0.5), secured=True).action is Action.emergency_brake
-    assert arb.decide(CLEAR, secured=False).action is Action.emergency_brake
+    assert arb.decide(CLEAR, secured=True).action is ShuntAction.monitor
+    assert arb.decide(ShuntingInputs.all_clear(speed_kmh=0.5), secured=True).action is ShuntAction.emergency_brake
+    assert arb.decide(CLEAR, secured=False).action is ShuntAction.emergency_brake
 
 
 def test_remote_driving_waives_route_and_signal_but_is_limited() -> None:
     arb = auto_arbiter(DrivingMode.remote)
     d = arb.decide(ShuntingInputs.all_clear(signal_ahead_open=False, plan_matches_route=False))
-    assert d.action is Action.move and d.speed_limit_kmh == 5.0 and d.distance_limit_m == 200.0
-    assert arb.decide(ShuntingInputs.all_clear(loco_healthy=False)).action is Action.brake
+    assert d.action is ShuntAction.move and d.speed_limit_kmh == 5.0 and d.distance_limit_m == 200.0
+    assert arb.decide(ShuntingInputs.all_clear(loco_healthy=False)).action is ShuntAction.brake
 
 
 def test_the_priority_table_puts_stopping_first_and_automatic_moving_last() -> None:
     actions = [a for _, a in PRIORITY]
-    assert actions[0] is Action.emergency_brake and actions[-1] is Action.move
-    assert actions.index(Action.manual) < actions.index(Action.brake)
+    assert actions[0] is ShuntAction.emergency_brake and actions[-1] is ShuntAction.move
+    assert actions.index(ShuntAction.manual) < actions.index(ShuntAction.brake)
 
 
 # ---- depot limits ---------------------------------------------------------------------------------------------------

@@ -17,7 +17,7 @@ from pathlib import Path
 import pytest
 from conftest import edit
 
-from liansuo.circuits.field import Changes, Field, field_plan
+from liansuo.circuits.field import Field, FieldChanges, field_plan
 from liansuo.circuits.railgeometry import geometry_of
 from liansuo.circuits.trackcircuits import SectionCircuit, build_circuit
 from liansuo.interlocking.cbi import Interlocking
@@ -198,7 +198,7 @@ def test_power_on_reads_the_field_as_it_is_built(name: str) -> None:
         out = Interlocking(table, rules).core.out
         wiring, board = Wiring(station, rules, Field(station, rules=rules)), RelayBoard()
         wiring.power_on(board, out)
-        assert wiring.field.take_changes() == Changes() and wiring.field.stamp == 1
+        assert wiring.field.take_changes() == FieldChanges() and wiring.field.stamp == 1
         by_hand = Wiring(station, rules, Field(station, rules=rules))
         by_hand.field.light(by_hand.commands_from(out))
         read = RelayBoard()

@@ -18,7 +18,6 @@ from liansuo.circuits.phase25.model import (
     Phase25HzCircuit,
     Phase25HzFaults,
     Phase25HzParams,
-    Phase25HzTrackRelay,
     adjusted_params,
 )
 
@@ -177,14 +176,16 @@ def test_more_axles_shunt_harder() -> None:
     assert not circuit.evaluate([(500.0 + 2.5 * i, 0.15) for i in range(8)]).relay_up_after(True)
 
 
-def test_stateful_relay_follows_a_train_through_the_section() -> None:
-    relay = Phase25HzTrackRelay(Phase25HzCircuit(600))
-    assert not relay.up  # starts down (fail-safe) until first evaluated
-    assert relay.update([])
+def test_the_relay_follows_a_train_through_the_section() -> None:
+    """The relay starts down (fail-safe) and each evaluation decides from the previous state (the hysteresis)."""
+    circuit = Phase25HzCircuit(600)
+    up = circuit.evaluate([]).relay_up_after(False)
+    assert up
     for x in (0.0, 150.0, 300.0, 599.0):
-        assert not relay.update([(x, STANDARD_SHUNT)])
-    assert relay.update([])
-    assert relay.state is not None and relay.state.voltage_V >= ADJUSTMENT_MIN
+        up = circuit.evaluate([(x, STANDARD_SHUNT)]).relay_up_after(up)
+        assert not up
+    state = circuit.evaluate([])
+    assert state.relay_up_after(up) and state.voltage_V >= ADJUSTMENT_MIN
 
 
 def test_shunts_outside_the_section_are_ignored() -> None:

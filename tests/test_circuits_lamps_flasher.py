@@ -7,14 +7,14 @@ import math
 import pytest
 
 from liansuo.circuits.flasher import ElectronicFlasher, RelayFlasher
-from liansuo.circuits.lamps import Lamp, LampRelay, SignalLamps
+from liansuo.circuits.lamps import LampRelay, SignalLamp, SignalLamps
 
 NOMINAL_RATE = 35.0
 
 
 # --- lamps ---------------------------------------------------------------------------------------------------------
 def test_lit_lamp_current_picks_dj_and_dark_lamp_drops_it() -> None:
-    lamp = Lamp("U")
+    lamp = SignalLamp("U")
     assert 170.0 <= lamp.current_mA(True) <= 200.0
     assert lamp.current_mA(False) == 0.0
     assert lamp.apply(True)
@@ -22,7 +22,7 @@ def test_lit_lamp_current_picks_dj_and_dark_lamp_drops_it() -> None:
 
 
 def test_main_filament_break_switches_to_backup_and_alarms() -> None:
-    lamp = Lamp("U")
+    lamp = SignalLamp("U")
     lamp.apply(True)
     lamp.break_filament("main")
     assert lamp.lit(True)
@@ -32,7 +32,7 @@ def test_main_filament_break_switches_to_backup_and_alarms() -> None:
 
 
 def test_both_filaments_broken_lamp_dark_and_dj_down() -> None:
-    lamp = Lamp("L")
+    lamp = SignalLamp("L")
     lamp.apply(True)
     lamp.break_filament("both")
     assert not lamp.lit(True)

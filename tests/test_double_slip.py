@@ -12,7 +12,7 @@ from conftest import Driver, edit, position
 
 from liansuo.cli.main import main
 from liansuo.interlocking.table.build import InterlockingTable, build_table
-from liansuo.interlocking.table.signed import Row, signed_table
+from liansuo.interlocking.table.signed import SignedRow, signed_table
 from liansuo.kit.source import StationError
 from liansuo.proving.oracle import Watch
 from liansuo.proving.verify import verify_station
@@ -36,7 +36,7 @@ def table() -> InterlockingTable:
 
 
 @pytest.fixture(scope="module")
-def rows(table: InterlockingTable) -> dict[str, Row]:
+def rows(table: InterlockingTable) -> dict[str, SignedRow]:
     return {r.route: r for g in signed_table(table).groups for r in g.rows}
 
 
@@ -72,8 +72,8 @@ ROADS = {
 
 
 @pytest.mark.parametrize("route", sorted(ROADS))
-def test_each_road_has_routes_with_the_pairs_printed_like_crossovers(table: InterlockingTable, rows: dict[str, Row],
-                                                                     route: str) -> None:
+def test_each_road_has_routes_with_the_pairs_printed_like_crossovers(table: InterlockingTable,
+                                                                     rows: dict[str, SignedRow], route: str) -> None:
     turnouts, road = ROADS[route]
     assert rows[route].cells["turnouts"] == turnouts
     assert "21-27DG" in rows[route].cells["sections"].split()
@@ -84,7 +84,7 @@ def test_each_road_has_routes_with_the_pairs_printed_like_crossovers(table: Inte
     assert lie == dict.fromkeys(("21", "23", "25", "27"), "reverse" if slip else "normal")
 
 
-def test_the_main_line_keeps_off_the_double_slip(table: InterlockingTable, rows: dict[str, Row]) -> None:
+def test_the_main_line_keeps_off_the_double_slip(table: InterlockingTable, rows: dict[str, SignedRow]) -> None:
     assert rows["X-XI"].cells["route"] == "至 IG" and rows["X-XI"].cells["turnouts"] == "1"
     assert rows["SI-X"].cells["turnouts"] == "1" and "21-27DG" not in rows["SI-X"].cells["sections"]
     # a receiving route onto the main line may be set while a shunting movement uses the double slip
@@ -92,7 +92,7 @@ def test_the_main_line_keeps_off_the_double_slip(table: InterlockingTable, rows:
 
 
 def test_the_straight_roads_cross_at_the_diamond_and_are_enemies(table: InterlockingTable,
-                                                                  rows: dict[str, Row]) -> None:
+                                                                  rows: dict[str, SignedRow]) -> None:
     straight = ("X-X4", "S4-X", "D1-S3", "S3-D1")
     for r in ROADS:
         assert table.routes[r].diamonds == (("21-27",) if r in straight else ())

@@ -7,7 +7,8 @@ import math
 
 import pytest
 
-from liansuo.simulation.trains.odometry import G, Odometer, simulate_run
+from liansuo.simulation.trains.odometry import G, Odometer
+from liansuo.simulation.trains.research.sliprun import simulate_run
 
 
 def run_wheel(o: Odometer, seconds: float, speed: float, accel: float = 0.0, dt: float = 0.1,

@@ -17,7 +17,7 @@ from consoletest import SIZE, message, run
 from liansuo.classroom.passwords import hash_password
 from liansuo.remote.app import RemoteConsoleApp
 from liansuo.remote.dashboard import DashboardScreen
-from liansuo.remote.link import Link
+from liansuo.remote.link import ServerLink
 from liansuo.remote.sim import LOST
 from liansuo.server.classroom import Classroom
 from liansuo.server.client import ClassroomClient
@@ -105,7 +105,7 @@ async def type_line(pilot: Any, line: str) -> None:
 
 @run
 async def test_a_trainee_sees_a_fault_as_the_cbi_shows_it_and_never_the_fault(server: Server) -> None:
-    app = RemoteConsoleApp(Link(server.url, {"role": "trainee", "seat": 1, "name": "Li"}))
+    app = RemoteConsoleApp(ServerLink(server.url, {"role": "trainee", "seat": 1, "name": "Li"}))
     async with app.run_test(size=SIZE) as pilot:
         await pilot.pause()
         await until(pilot, lambda: app.remote.live and band(app, "IG") == BAND_COLOUR["free"])
@@ -122,7 +122,7 @@ async def test_a_trainee_sees_a_fault_as_the_cbi_shows_it_and_never_the_fault(se
 
 @run
 async def test_a_trainees_instructor_command_is_refused_with_the_reason(server: Server) -> None:
-    app = RemoteConsoleApp(Link(server.url, {"role": "trainee", "seat": 1, "name": "Li"}))
+    app = RemoteConsoleApp(ServerLink(server.url, {"role": "trainee", "seat": 1, "name": "Li"}))
     async with app.run_test(size=SIZE) as pilot:
         await pilot.pause()
         await type_line(pilot, "fault broken-rail IG")
@@ -139,7 +139,7 @@ async def test_a_trainees_instructor_command_is_refused_with_the_reason(server: 
 
 @run
 async def test_a_route_set_on_the_trainees_console_is_locked_on_the_server(server: Server) -> None:
-    app = RemoteConsoleApp(Link(server.url, {"role": "trainee", "seat": 2, "name": "Wang"}))
+    app = RemoteConsoleApp(ServerLink(server.url, {"role": "trainee", "seat": 2, "name": "Wang"}))
     async with app.run_test(size=SIZE) as pilot:
         await pilot.pause()
         await type_line(pilot, "route X XI")
@@ -157,7 +157,7 @@ async def test_a_route_set_on_the_trainees_console_is_locked_on_the_server(serve
 @run
 async def test_the_instructor_opens_a_seat_from_the_dashboard_and_faults_it(server: Server) -> None:
     with ClassroomClient.trainee(server.url, seat=1, name="Li"):
-        app = RemoteConsoleApp(Link(server.url, {"role": "instructor", "password": PASSWORD}))
+        app = RemoteConsoleApp(ServerLink(server.url, {"role": "instructor", "password": PASSWORD}))
         async with app.run_test(size=SIZE) as pilot:
             await pilot.pause()
             assert isinstance(app.screen, DashboardScreen)
@@ -185,7 +185,7 @@ async def test_the_instructor_opens_a_seat_from_the_dashboard_and_faults_it(serv
 
 @run
 async def test_connection_lost_shows_the_fail_safe_picture_and_comes_back(server: Server) -> None:
-    app = RemoteConsoleApp(Link(server.url, {"role": "trainee", "seat": 1, "name": "Li"}))
+    app = RemoteConsoleApp(ServerLink(server.url, {"role": "trainee", "seat": 1, "name": "Li"}))
     async with app.run_test(size=SIZE) as pilot:
         await pilot.pause()
         await until(pilot, lambda: app.remote.live and band(app, "IG") == BAND_COLOUR["free"])
@@ -269,7 +269,7 @@ async def test_the_login_screen_lists_the_seats_asks_again_after_a_refusal_then_
 
 @run
 async def test_a_trainee_reads_the_exercise_started_on_the_seat_and_its_score_at_the_end(server: Server) -> None:
-    app = RemoteConsoleApp(Link(server.url, {"role": "trainee", "seat": 1, "name": "Li"}))
+    app = RemoteConsoleApp(ServerLink(server.url, {"role": "trainee", "seat": 1, "name": "Li"}))
     async with app.run_test(size=SIZE) as pilot:
         await pilot.pause()
         with ClassroomClient.instructor(server.url, PASSWORD) as teacher:

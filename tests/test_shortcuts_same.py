@@ -34,7 +34,7 @@ from liansuo.proving.verify import verify_station
 from liansuo.simulation.sim import Simulation
 from liansuo.simulation.trains import fleet as fleet_module
 from liansuo.simulation.trains.drivers import Lookout
-from liansuo.simulation.trains.movement import Position, Track
+from liansuo.simulation.trains.movement import Position, TrackGeometry
 from liansuo.simulation.trains.odometerfeed import MAX_PENDING, OdometerFeed
 from liansuo.simulation.trains.odometry import Odometer
 from liansuo.stations.hubgen import generate_hub
@@ -69,7 +69,7 @@ class Ahead:
     what: str
 
 
-def look_ahead(track: Track, pos: Position, lookout: Lookout, aspects: dict[str, str], horizon: float,
+def look_ahead(track: TrackGeometry, pos: Position, lookout: Lookout, aspects: dict[str, str], horizon: float,
                margin: float, *, shunting: bool, boundary_stops: bool) -> list[Ahead]:
     """Signals, buffer stops and (optionally) the boundary ahead along the rails as they lie now, up to the first
     stop: a closed signal (less ``margin``), a buffer stop or the boundary (less the buffer margin)."""
@@ -114,7 +114,7 @@ class AimChecked:
         self.bound = 0  # answers limited by something ahead (a signal, a buffer stop, the boundary)
         self.real = fleet_module.aim
 
-    def __call__(self, track: Track, pos: Position, aspects: dict[str, str], lookout: Lookout, horizon: float,
+    def __call__(self, track: TrackGeometry, pos: Position, aspects: dict[str, str], lookout: Lookout, horizon: float,
                  margin: float, shunting: bool, boundary_stops: bool, current_limit_ms: float, vmax_ms: float,
                  brake_ms2: float, lead_m: float) -> tuple[float, str]:
         got = self.real(track, pos, aspects, lookout, horizon, margin, shunting, boundary_stops, current_limit_ms,

@@ -16,7 +16,7 @@ from openpyxl import load_workbook
 from liansuo.cli.main import main
 from liansuo.interlocking.table.build import build_table
 from liansuo.interlocking.table.schema import TABLE_SCHEMA
-from liansuo.interlocking.table.signed import Row, signed_table
+from liansuo.interlocking.table.signed import SignedRow, signed_table
 from liansuo.interlocking.table.text import as_csv, as_json, as_text
 from liansuo.stations.loader import load, load_text
 
@@ -25,7 +25,7 @@ def width(line: str) -> int:
     return sum(2 if unicodedata.east_asian_width(c) in "WF" else 1 for c in line)
 
 
-def rows(station: str) -> dict[str, tuple[str, Row]]:
+def rows(station: str) -> dict[str, tuple[str, SignedRow]]:
     """route id -> (group name, row)"""
     return {r.route: (g.name, r) for g in signed_table(build_table(load(station))).groups for r in g.rows}
 

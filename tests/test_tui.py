@@ -366,10 +366,10 @@ async def test_recording_and_replay_reproduce_the_session(tmp_path: Path) -> Non
 
 def test_variant_buttons_become_the_via_of_the_route() -> None:
     from liansuo.simulation import Simulation
-    from liansuo.tui.operate import Operator
+    from liansuo.tui.operate import ConsoleOperator
 
     sim = Simulation("gaotie")
-    op = Operator(sim)
+    op = ConsoleOperator(sim)
     assert op.press(Ref("button", "X", "train")).command == ""
     assert "via BA1" in op.press(Ref("button", "BA1", "variant")).message
     out = op.press(Ref("button", "XI", "train"))

@@ -22,7 +22,7 @@ from liansuo.tui import longrun
 from liansuo.tui.app import ConsoleApp
 from liansuo.tui.dialogs import ConfirmScreen, HelpScreen, PasswordScreen, QuitScreen
 from liansuo.tui.layout import Ref
-from liansuo.tui.operate import Operator
+from liansuo.tui.operate import ConsoleOperator
 from liansuo.tui.safeapp import ConsoleScreen
 
 
@@ -134,16 +134,16 @@ async def test_shrinking_the_window_through_1x1_with_a_dialog_or_the_palette_ope
 @run
 async def test_an_error_in_a_handler_is_shown_in_the_alarm_panel_and_the_console_carries_on(
         monkeypatch: pytest.MonkeyPatch) -> None:
-    real = Operator.press
+    real = ConsoleOperator.press
     calls = {"n": 0}
 
-    def press_failing_once(self: Operator, ref: Ref) -> Any:
+    def press_failing_once(self: ConsoleOperator, ref: Ref) -> Any:
         calls["n"] += 1
         if calls["n"] == 1:
             raise ZeroDivisionError("injected for the test")
         return real(self, ref)
 
-    monkeypatch.setattr(Operator, "press", press_failing_once)
+    monkeypatch.setattr(ConsoleOperator, "press", press_failing_once)
     app = ConsoleApp("jiaopei", paused=True)
     async with app.run_test(size=SIZE) as pilot:
         await pilot.pause()  # the diagram centres itself after its first refresh

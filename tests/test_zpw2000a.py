@@ -20,7 +20,6 @@ from liansuo.circuits.zpw.model import (
     ZpwCircuit,
     ZpwFaults,
     ZpwState,
-    ZpwTrackRelay,
     capacitor_positions,
     layout_params,
     section_circuit,
@@ -244,12 +243,14 @@ def test_open_capacitor_leaves_the_relay_up_until_the_first_train() -> None:
     circuit = ZpwCircuit(1400.0, "2300-1", standard_positions(1400.0))
     fault = ZpwFaults(capacitors={3: "open"})
     assert P.drop_mV < circuit.adjustment(fault).voltage_mV < P.pickup_mV
-    relay = ZpwTrackRelay(circuit)
-    assert relay.update() is True  # starts down, picks up
-    assert relay.update(faults=fault) is True  # the fault alone does not drop it
-    assert relay.update([(700.0, 0.15)], fault) is False
-    assert relay.update([], fault) is False  # the train has gone: still down
-    assert relay.update() is True  # capacitor replaced
+    up = False  # the relay starts down (fail-safe); each evaluation decides from the previous state
+    for shunts, faults, then in (([], None, True),  # picks up
+                                  ([], fault, True),  # the fault alone does not drop it
+                                  ([(700.0, 0.15)], fault, False),
+                                  ([], fault, False),  # the train has gone: still down
+                                  ([], None, True)):  # capacitor replaced
+        up = circuit.evaluate(shunts, faults).relay_up_after(up)
+        assert up is then
 
 
 def test_broken_rail_insulation_short_and_ballast() -> None:

@@ -43,7 +43,7 @@ class FieldCommands:
 
 
 @dataclass
-class Changes:
+class FieldChanges:
     tracks: set[str] = field(default_factory=set)
     turnouts: set[str] = field(default_factory=set)
     signals: set[str] = field(default_factory=set)
@@ -113,8 +113,8 @@ class Field:
         self._moving: set[str] = set()
         self.stamp = 0  # counts the batches of changes taken: what reads the field can tell when nothing changed
         self.lamp_stamp = 0  # counts the lamp commands applied: what reads the lamps can tell when none changed
-        self._changes = Changes(set(station.sections), set(station.turnouts), set(station.signals),
-                                set(self.doors))
+        self._changes = FieldChanges(set(station.sections), set(station.turnouts), set(station.signals),
+                                     set(self.doors))
 
     # ---- occupancy ------------------------------------------------------------------------------------------
     def occupy(self, section: str) -> None:
@@ -325,9 +325,9 @@ class Field:
         """A turnout's indication may have changed outside a step (a train trailed through it)."""
         self._changes.turnouts.add(turnout)
 
-    def take_changes(self) -> Changes:
+    def take_changes(self) -> FieldChanges:
         out = self._changes
-        self._changes = Changes()
+        self._changes = FieldChanges()
         if out.tracks or out.turnouts or out.signals or out.doors:
             self.stamp += 1
         return out

@@ -42,7 +42,7 @@ class LampRelay:
 
 
 @dataclass
-class Lamp:
+class SignalLamp:
     """One double-filament lamp with its DJ."""
 
     name: str
@@ -101,17 +101,17 @@ class SignalLamps:
     """The lamps of one signal, by name (e.g. ``U``, ``L``, ``H``, ``2U``, ``B``, ``A``)."""
 
     def __init__(self, lamp_names: Iterable[str]) -> None:
-        self.lamps: dict[str, Lamp] = {}
+        self.lamps: dict[str, SignalLamp] = {}
         for name in lamp_names:
             if name in self.lamps:
                 raise ValueError(f"lamp {name!r} listed twice")
-            self.lamps[name] = Lamp(name)
+            self.lamps[name] = SignalLamp(name)
         self.commanded: set[str] = set()
 
-    def __getitem__(self, name: str) -> Lamp:
+    def __getitem__(self, name: str) -> SignalLamp:
         return self._lamp(name)
 
-    def _lamp(self, name: str) -> Lamp:
+    def _lamp(self, name: str) -> SignalLamp:
         try:
             return self.lamps[name]
         except KeyError:

@@ -19,7 +19,7 @@ from typing import Any
 
 from liansuo.classroom.exercise import DIFFICULTIES, Exercise, check_goal
 from liansuo.classroom.roles import command_word
-from liansuo.classroom.score import Inputs, score
+from liansuo.classroom.score import ScoreInputs, score
 from liansuo.classroom.unsafe import (
     RED_BAND,
     Planted,
@@ -58,7 +58,7 @@ class UnsafeAction:
 
 
 @dataclass(frozen=True)
-class Finding:
+class ExpectedFinding:
     finding: str
     fault: str
     accept: tuple[str, ...]
@@ -114,9 +114,9 @@ class Assessment:
         self._check()
 
     # ---- what there is to find ------------------------------------------------------------------------------
-    def _findings(self) -> list[Finding]:
+    def _findings(self) -> list[ExpectedFinding]:
         injected = [f"{f.kind} {f.target}" for f in self.planted.faults]
-        out = [Finding(s.finding or (f"fault {s.fault}" if s.fault else ""), s.fault, s.accept)
+        out = [ExpectedFinding(s.finding or (f"fault {s.fault}" if s.fault else ""), s.fault, s.accept)
                for s in self.exercise.diagnosis if not s.fault or s.fault in injected]
         covered = {s.fault for s in self.exercise.diagnosis}
         for f in self.planted.faults:
@@ -125,7 +125,7 @@ class Assessment:
                 continue
             covered.add(key)
             red = f.kind in RED_BAND or (f.kind == "capacitor" and f.get("mode") == "short")
-            out.append(Finding(f"fault {key}", key, (key, f"red-band {f.target}") if red else (key,)))
+            out.append(ExpectedFinding(f"fault {key}", key, (key, f"red-band {f.target}") if red else (key,)))
         return out
 
     # ---- time -----------------------------------------------------------------------------------------------
@@ -241,8 +241,8 @@ class Assessment:
         goals = tuple((g.points, at) for g, at in zip(self.exercise.goals, self.goal_met_at, strict=True))
         wrong = sum(not d.correct for d in self.diagnoses)
         refused = sum(not e.ok for e in self.entries)
-        return score(self.exercise.scoring, Inputs(goals, tuple(self.diagnosed_at), refused, len(self.unsafe),
-                                                   wrong, self.exercise.time_limit))
+        return score(self.exercise.scoring, ScoreInputs(goals, tuple(self.diagnosed_at), refused, len(self.unsafe),
+                                                        wrong, self.exercise.time_limit))
 
     def sealed_uses(self) -> dict[str, int]:
         """The sealed buttons the trainee used (铅封计数 since the exercise began; the setup's are not counted)."""

@@ -32,7 +32,7 @@ from dataclasses import dataclass, field
 from importlib.resources import files
 from pathlib import Path
 
-from liansuo.classroom.schema import Draw, ExerciseFile, Faults, Scoring
+from liansuo.classroom.schema import ExerciseFile, FaultDraw, Faults, Scoring
 from liansuo.kit.filekind import read_source
 from liansuo.kit.source import Diagnostic, Source, StationError
 from liansuo.simulation.diagnosis import DIAGNOSIS_KINDS
@@ -119,7 +119,7 @@ def _expect(line: str) -> str:
     return line if line.strip().startswith("expect") else f"expect {line.strip()}"
 
 
-def _draws(draw: int | Draw) -> dict[int, int]:
+def _draws(draw: int | FaultDraw) -> dict[int, int]:
     if isinstance(draw, int):
         return dict.fromkeys(DIFFICULTIES, draw)
     return {1: draw.easy, 2: draw.medium, 3: draw.hard}

@@ -54,7 +54,7 @@ class Goal(_File):
                                                          "together are worth scoring.goals")
 
 
-class Draw(_File):
+class FaultDraw(_File):
     """How many faults are drawn from the pool at each difficulty."""
 
     easy: int = Field(1, ge=0, le=20, description="faults drawn at difficulty 1")
@@ -67,18 +67,18 @@ class Faults(_File):
 
     fixed: list[FaultLine] = Field([], description="fault lines always injected, after the setup")
     pool: list[FaultLine] = Field([], description="fault lines to draw from (reproducibly, from the seed)")
-    draw: int | Draw = Field(1, description="how many to draw from the pool: a number, or one per difficulty "
+    draw: int | FaultDraw = Field(1, description="how many to draw from the pool: a number, or one per difficulty "
                                             "({easy: 1, medium: 1, hard: 2})")
 
     @field_validator("draw")
     @classmethod
-    def _count(cls, value: int | Draw) -> int | Draw:
+    def _count(cls, value: int | FaultDraw) -> int | FaultDraw:
         if isinstance(value, int) and not 0 <= value <= 20:
             raise ValueError("draw from 0 to 20 faults")
         return value
 
 
-class Finding(_File):
+class FindingEntry(_File):
     """One thing the trainee must find and register with 'diagnose KIND ELEMENT'."""
 
     fault: str = Field("", description="the injected fault this finding is about, 'KIND TARGET' (e.g. 'broken-rail "
@@ -135,7 +135,7 @@ class ExerciseFile(_File):
     goal: Goal | None = Field(None, description="what counts as done (one goal); empty for a lesson with no goal")
     goals: list[Goal] = Field([], description="what counts as done, goal by goal; each is met once its expect lines "
                                               "all hold")
-    diagnosis: list[Finding] = Field([], description="what the trainee must find; every injected fault without a "
+    diagnosis: list[FindingEntry] = Field([], description="what the trainee must find; every injected fault without a "
                                                      "finding here is found by 'diagnose KIND TARGET'")
     scoring: Scoring = Field(Scoring(), description="the points of the score")
 

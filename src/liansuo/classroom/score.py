@@ -20,7 +20,7 @@ from liansuo.classroom.schema import Scoring
 
 
 @dataclass(frozen=True)
-class Inputs:
+class ScoreInputs:
     """What the score is computed from (times in seconds since the exercise began)."""
 
     goal_points: tuple[tuple[float, float | None], ...]  # (points, met at or None)
@@ -38,7 +38,7 @@ def _share(t: float, full_until: float, limit: float, floor: float) -> float:
     return max(floor, 1.0 - (1.0 - floor) * (t - full_until) / (limit - full_until))
 
 
-def score(rules: Scoring, given: Inputs) -> dict[str, float]:
+def score(rules: Scoring, given: ScoreInputs) -> dict[str, float]:
     """The score's parts and total: ``goals``, ``diagnosis``, ``time`` (earned), ``refused``, ``unsafe``,
     ``wrong_diagnosis`` (lost, as negative numbers), ``total`` and ``max``."""
     goals_max = rules.goals + (0.0 if given.findings else rules.diagnosis)

@@ -15,7 +15,7 @@ from liansuo.interlocking.io import Alarm, Event, Outputs, RelayBoard
 from liansuo.interlocking.lifecycle import RouteLifecycle
 from liansuo.interlocking.locks import LockLedger
 from liansuo.interlocking.operations import Operator
-from liansuo.interlocking.quiet import Mark, Quiet, quiet_after
+from liansuo.interlocking.quiet import CycleMark, Quiet, quiet_after
 from liansuo.interlocking.state import RouteState
 from liansuo.interlocking.table.route import InterlockingTable
 from liansuo.rules import RuleSet
@@ -48,7 +48,7 @@ class Interlocking:
             core.now = t
             core.cycles += 1
             return core.out
-        before = Mark.of(core)
+        before = CycleMark.of(core)
         changes = core.take_inputs(t)
         if changes.tracks:
             self.lifecycle.check_spad(changes.tracks)

@@ -27,7 +27,7 @@ if TYPE_CHECKING:
 
 
 @dataclass(frozen=True)
-class Mark:
+class CycleMark:
     """What a cycle may change, counted before it: compared after it (:func:`quiet_after`)."""
 
     logged: int
@@ -39,10 +39,10 @@ class Mark:
     dirty: bool
 
     @staticmethod
-    def of(core: Core) -> Mark:
-        return Mark(core.logged, len(core.alarms), core.locks.version, len(core.moving), len(core.queue),
-                    tuple(sl.state.value for sl in core.station_links.values()),
-                    core.codes_dirty or (core.blocks_dirty and bool(core.autoblock.signals)))
+    def of(core: Core) -> CycleMark:
+        return CycleMark(core.logged, len(core.alarms), core.locks.version, len(core.moving), len(core.queue),
+                         tuple(sl.state.value for sl in core.station_links.values()),
+                         core.codes_dirty or (core.blocks_dirty and bool(core.autoblock.signals)))
 
 
 @dataclass(frozen=True)
@@ -63,7 +63,7 @@ class Quiet:
                 and all(not now >= at for at in self.due))
 
 
-def quiet_after(core: Core, before: Mark, changes: Changes, routes_settled: bool) -> Quiet | None:
+def quiet_after(core: Core, before: CycleMark, changes: Changes, routes_settled: bool) -> Quiet | None:
     """The :class:`Quiet` of the cycle just run, if it changed nothing; None if it changed something or may act
     again on its own (a guide aspect without a route, a move waiting in the queue while fewer than the allowed
     moves run)."""
@@ -73,7 +73,7 @@ def quiet_after(core: Core, before: Mark, changes: Changes, routes_settled: bool
     out = core.out
     if out.changed_signals or out.changed_turnouts or out.line_out or out.axle_resets or core.guide_only:
         return None
-    if Mark.of(core) != before or before.dirty:
+    if CycleMark.of(core) != before or before.dirty:
         return None
     if core.queue and len(core.moving) < core.rules.turnout_concurrency:
         return None

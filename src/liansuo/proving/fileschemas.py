@@ -27,7 +27,7 @@ class _File(BaseModel):
     model_config = ConfigDict(extra="forbid", strict=True)
 
 
-class ScriptTest(_File):
+class ScriptTestModel(_File):
     """One test of a script, run on a fresh simulation."""
 
     name: str = Field(description="what the test shows; liansuo test -k TEXT selects by it")
@@ -41,7 +41,7 @@ class ScriptFile(_File):
     model_config = ConfigDict(title="liansuo test script")
 
     station: str = Field(description=STATION)
-    tests: list[ScriptTest] = Field(min_length=1, description="the tests, each run on a fresh simulation")
+    tests: list[ScriptTestModel] = Field(min_length=1, description="the tests, each run on a fresh simulation")
     cycle_ms: float = Field(250, ge=10, le=2000, description="the interlocking's cycle in milliseconds")
     safety: bool = Field(False, description="run the independent safety oracle every cycle (docs/safety.md)")
 

@@ -59,14 +59,14 @@ def is_script(path: Path) -> bool:
     return bool(_STATION_KEY.search(head) and _TESTS_KEY.search(head))
 
 
-def pytest_collect_file(file_path: Path, parent: pytest.Collector) -> ScriptFile | None:
+def pytest_collect_file(file_path: Path, parent: pytest.Collector) -> ScriptCollector | None:
     if file_path.suffix not in (".yaml", ".yml"):
         return None
     patterns: list[str] = parent.config.getini("liansuo_scripts")
     wanted = any(fnmatch(file_path.name, p) for p in patterns) or parent.session.isinitpath(file_path)
     if not wanted or not is_script(file_path):
         return None
-    return ScriptFile.from_parent(parent, path=file_path)
+    return ScriptCollector.from_parent(parent, path=file_path)
 
 
 class ScriptError(Exception):
@@ -77,7 +77,7 @@ class ScriptFailure(Exception):
     """A script test failed: the outcome says which step, what was expected and what the state was."""
 
 
-class ScriptFile(pytest.File):
+class ScriptCollector(pytest.File):
     def collect(self) -> Iterator[ScriptItem]:
         from liansuo.interlocking.table.build import build_table
         from liansuo.kit.source import StationError

@@ -20,7 +20,7 @@ from textual.binding import Binding, BindingType
 from liansuo.classroom.roles import INSTRUCTOR
 from liansuo.kit.printable import printable
 from liansuo.remote.dashboard import DashboardScreen, ExerciseChoice, ExercisePicker
-from liansuo.remote.link import Link, Unlinked
+from liansuo.remote.link import ServerLink, Unlinked
 from liansuo.remote.login import LoginScreen
 from liansuo.remote.sim import LOST, NOT_IN, RemoteSimulation
 from liansuo.tui.app import SPEEDS, ConsoleApp
@@ -35,7 +35,7 @@ class RemoteConsoleApp(ConsoleApp):
         Binding("f3", "dashboard", "seats", key_display="F3"),
     ]
 
-    def __init__(self, link: Link | Unlinked, *, mute: bool = False) -> None:
+    def __init__(self, link: ServerLink | Unlinked, *, mute: bool = False) -> None:
         """On a seat through ``link``; or, :class:`Unlinked`, the login screen first over the station drawn dark."""
         self.link = link
         self.remote = RemoteSimulation(link)
@@ -49,7 +49,7 @@ class RemoteConsoleApp(ConsoleApp):
 
     @property
     def logged_in(self) -> bool:
-        return isinstance(self.link, Link)
+        return isinstance(self.link, ServerLink)
 
     @property
     def seat(self) -> int:
@@ -58,12 +58,12 @@ class RemoteConsoleApp(ConsoleApp):
     def started(self) -> None:
         self.remote.step()
         self.refresh_views()
-        if not isinstance(self.link, Link):
+        if not isinstance(self.link, ServerLink):
             self.push_screen(LoginScreen(self.link.url, self.link.lobby), self.logged)
             return
         self.greet()
 
-    def logged(self, link: Link | None) -> None:
+    def logged(self, link: ServerLink | None) -> None:
         """The login screen's link: the console now shows and operates that seat (or the instructor's)."""
         if link is None:
             self.exit()
@@ -77,7 +77,7 @@ class RemoteConsoleApp(ConsoleApp):
         self.greet()
 
     def greet(self) -> None:
-        if self.instructor and isinstance(self.link, Link):
+        if self.instructor and isinstance(self.link, ServerLink):
             self.say(f"seat {self.seat}: every command goes to this seat; F3 the seats, F2 faults and trains")
             self.push_screen(DashboardScreen(self.link))
         else:
@@ -158,7 +158,7 @@ class RemoteConsoleApp(ConsoleApp):
         return ""
 
     def action_dashboard(self) -> None:
-        if not self.instructor or not isinstance(self.link, Link):
+        if not self.instructor or not isinstance(self.link, ServerLink):
             self.say("the seats' dashboard is the instructor's", False)
             return
         if not isinstance(self.screen, DashboardScreen):

@@ -53,7 +53,7 @@ def hello(args: argparse.Namespace) -> dict[str, Any] | None:
 
 
 def cmd_connect(args: argparse.Namespace) -> int:
-    from liansuo.remote.link import Link, LinkError, Unlinked, lobby
+    from liansuo.remote.link import LinkError, ServerLink, Unlinked, lobby
     from liansuo.tui.cli import closed
 
     try:
@@ -63,8 +63,8 @@ def cmd_connect(args: argparse.Namespace) -> int:
     except LoginError as exc:
         return refuse("tui", str(exc), Exit.USAGE)
     try:
-        link: Link | Unlinked = Unlinked(args.connect, lobby(args.connect)) if greeting is None \
-            else Link(args.connect, greeting)
+        link: ServerLink | Unlinked = Unlinked(args.connect, lobby(args.connect)) if greeting is None \
+            else ServerLink(args.connect, greeting)
     except LinkError as exc:
         return refuse("tui", str(exc), Exit.USAGE)
     from liansuo.remote.app import RemoteConsoleApp

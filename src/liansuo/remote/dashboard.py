@@ -23,7 +23,7 @@ from textual.widgets import Button, DataTable, Footer, Label, OptionList, Select
 
 from liansuo.classroom.exercise import bundled_exercises
 from liansuo.kit.printable import printable
-from liansuo.remote.link import Link
+from liansuo.remote.link import ServerLink
 from liansuo.tui.panels import clock_text
 
 COLUMNS = ("seat", "trainee", "connected", "station", "t", "clock", "exercise", "progress", "score", "alarms",
@@ -136,7 +136,7 @@ class DashboardScreen(Screen[None]):
             super().__init__()
             self.seat = seat
 
-    def __init__(self, link: Link) -> None:
+    def __init__(self, link: ServerLink) -> None:
         super().__init__()
         self.link = link
         self._shown: list[tuple[str, ...]] = []

@@ -56,7 +56,7 @@ def dial(url: str, hello: dict[str, Any], timeout: float = OPEN_TIMEOUT_S) -> tu
     return ws, reply
 
 
-class Link:
+class ServerLink:
     """A console's connection to the server (see the module's docstring). Thread-safe; never raises once open."""
 
     def __init__(self, url: str, hello: dict[str, Any], *, timeout: float = REQUEST_TIMEOUT_S) -> None:

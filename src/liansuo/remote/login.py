@@ -18,7 +18,7 @@ from textual.screen import ModalScreen
 from textual.widgets import Button, Input, Label, RadioButton, RadioSet, Static
 
 from liansuo.kit.printable import printable
-from liansuo.remote.link import Link, LinkError
+from liansuo.remote.link import LinkError, ServerLink
 
 
 def hello_of(role: str, name: str, seat: str, password: str) -> dict[str, Any] | str:
@@ -41,7 +41,7 @@ def seats_text(lobby: dict[str, Any]) -> str:
     return " · ".join(out)
 
 
-class LoginScreen(ModalScreen[Link | None]):
+class LoginScreen(ModalScreen[ServerLink | None]):
     """The login form over the station drawn dark; it is dismissed with the open link (None: the console closes)."""
 
     DEFAULT_CSS = """
@@ -107,7 +107,7 @@ class LoginScreen(ModalScreen[Link | None]):
     @work(thread=True, exclusive=True)
     def dial(self, hello: dict[str, Any]) -> None:
         try:
-            link = Link(self.url, hello)
+            link = ServerLink(self.url, hello)
         except LinkError as exc:
             self.app.call_from_thread(self.show, str(exc))
             return

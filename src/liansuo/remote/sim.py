@@ -18,7 +18,7 @@ from typing import Any
 from liansuo.classroom.snapshot import SnapshotView
 from liansuo.interlocking.io import Event, Result
 from liansuo.interlocking.table.build import InterlockingTable, build_table
-from liansuo.remote.link import Link, Unlinked
+from liansuo.remote.link import ServerLink, Unlinked
 from liansuo.rules import RuleSet, load_rules
 from liansuo.simulation.language import Language
 from liansuo.simulation.sim import LANGUAGE, Simulation
@@ -112,7 +112,7 @@ class RemoteSimulation:
 
     language: Language[Simulation] = LANGUAGE  # for completion: the same words the server's simulation reads
 
-    def __init__(self, link: Link | Unlinked) -> None:
+    def __init__(self, link: ServerLink | Unlinked) -> None:
         self.link = link
         self.rules: RuleSet = load_rules()
         self.station: Station = load_station(dict(link.welcome.get("station") or {}), self.rules)
@@ -126,10 +126,10 @@ class RemoteSimulation:
         self.live = False  # showing the server's state (False: the fail-safe picture, or nothing received yet)
         self.seat = link.seat
         self._log: deque[Event] = deque(maxlen=MAX_EVENTS)
-        self._show(dark(self.station, 0.0, LOST if isinstance(link, Link) else NOT_IN))
+        self._show(dark(self.station, 0.0, LOST if isinstance(link, ServerLink) else NOT_IN))
         self.live = False
 
-    def attach(self, link: Link) -> None:
+    def attach(self, link: ServerLink) -> None:
         """Logged in: the seat's state from now on comes through ``link``."""
         self.link, self.seat = link, link.seat
 

@@ -14,7 +14,7 @@ class _Message(BaseModel):
     model_config = ConfigDict(extra="forbid", strict=True)
 
 
-class Hello(_Message):
+class HelloMessage(_Message):
     type: Literal["hello"]
     role: Literal["trainee", "instructor"]
     seat: int | None = Field(None, ge=1, le=64, description="the trainee's seat")
@@ -23,38 +23,38 @@ class Hello(_Message):
     password: str | None = Field(None, max_length=256, description="the instructor's password")
 
 
-class Lobby(_Message):
+class LobbyMessage(_Message):
     """Instead of a hello: what a login screen shows before anyone logs in (the station, the seats); then the
     server closes the connection."""
 
     type: Literal["lobby"]
 
 
-class Command(_Message):
+class CommandMessage(_Message):
     type: Literal["command"]
     id: int = Field(ge=0, le=2**53)
     line: str = Field(max_length=2000)
     seat: int | None = Field(None, ge=1, le=64, description="the instructor's target seat; a trainee's is its own")
 
 
-class Watch(_Message):
+class WatchMessage(_Message):
     type: Literal["watch"]
     seat: int = Field(ge=1, le=64)
 
 
-class Clock(_Message):
+class ClockMessage(_Message):
     type: Literal["clock"]
     seats: Seats
     action: Literal["pause", "run"] | None = None
     speed: float | None = Field(None, allow_inf_nan=False)
 
 
-class Reset(_Message):
+class ResetMessage(_Message):
     type: Literal["reset"]
     seats: Seats
 
 
-class Exercise(_Message):
+class ExerciseMessage(_Message):
     type: Literal["exercise"]
     seats: Seats
     name: str = Field(max_length=200, description="a bundled exercise, or one in the server's --exercise-dir")
@@ -62,12 +62,13 @@ class Exercise(_Message):
     seed: int | None = Field(None, ge=0, le=2**31, description="the same seed draws the same faults on every seat")
 
 
-class Stop(_Message):
+class StopMessage(_Message):
     type: Literal["stop"]
     seats: Seats
 
 
-ClientMessage = Hello | Lobby | Command | Watch | Clock | Reset | Exercise | Stop
+ClientMessage = (HelloMessage | LobbyMessage | CommandMessage | WatchMessage | ClockMessage | ResetMessage
+                 | ExerciseMessage | StopMessage)
 Message = Annotated[ClientMessage, Field(discriminator="type")]
 MESSAGE: TypeAdapter[ClientMessage] = TypeAdapter(Message)
 

@@ -24,7 +24,18 @@ from liansuo.classroom.passwords import matches
 from liansuo.classroom.roles import INSTRUCTOR, TRAINEE
 from liansuo.classroom.snapshot import EventCursor
 from liansuo.server.classroom import Classroom, SeatError
-from liansuo.server.messages import MESSAGE, ClientMessage, Clock, Command, Exercise, Hello, Lobby, Stop, Watch, problem
+from liansuo.server.messages import (
+    MESSAGE,
+    ClientMessage,
+    ClockMessage,
+    CommandMessage,
+    ExerciseMessage,
+    HelloMessage,
+    LobbyMessage,
+    StopMessage,
+    WatchMessage,
+    problem,
+)
 
 TICK_S = 0.05  # the clocks' pace on the wall clock
 PUSH_S = 0.25  # a snapshot to each client this often
@@ -86,11 +97,11 @@ class ClassroomServer:
         try:
             raw = await asyncio.wait_for(ws.recv(), HELLO_TIMEOUT_S)
             hello = MESSAGE.validate_json(raw)
-            if isinstance(hello, Lobby):
+            if isinstance(hello, LobbyMessage):
                 await ws.send(json.dumps(self.lobby()))
                 await ws.close(1000, "lobby")
                 return None
-            if not isinstance(hello, Hello):
+            if not isinstance(hello, HelloMessage):
                 raise SeatError("the first message is a hello: {\"type\": \"hello\", \"role\": ...}")
             client = self.admit(hello)
         except (TimeoutError, ValidationError, SeatError, ValueError) as exc:
@@ -111,7 +122,7 @@ class ClassroomServer:
                 "seats": [{"seat": s.number, "trainee": s.trainee, "connected": s.connected}
                           for s in room.seats.values()]}
 
-    def admit(self, hello: Hello) -> Client:
+    def admit(self, hello: HelloMessage) -> Client:
         if hello.role == INSTRUCTOR:
             if hello.password is None or not matches(hello.password, self.instructor_hash):
                 raise SeatError("wrong instructor password")
@@ -147,9 +158,9 @@ class ClassroomServer:
 
     def dispatch(self, client: Client, msg: ClientMessage) -> dict[str, Any]:
         instructor = client.role == INSTRUCTOR
-        if isinstance(msg, Hello | Lobby):
+        if isinstance(msg, HelloMessage | LobbyMessage):
             raise SeatError(f"a {msg.type} is sent once, first")
-        if isinstance(msg, Command):
+        if isinstance(msg, CommandMessage):
             if msg.seat is not None and msg.seat != client.seat and not instructor:
                 raise SeatError("a trainee operates only their own seat")
             seat = msg.seat if instructor and msg.seat is not None else client.seat
@@ -157,21 +168,21 @@ class ClassroomServer:
             return {"type": "answer", "id": msg.id, "seat": seat, "ok": r.ok, "message": r.message}
         if not instructor:
             raise SeatError(f"'{msg.type}' is the instructor's: a trainee sends commands only")
-        if isinstance(msg, Watch):
+        if isinstance(msg, WatchMessage):
             self.classroom.seat(msg.seat)
             client.seat, client.cursor = msg.seat, EventCursor()
             return {"type": "ok", "message": f"watching seat {msg.seat}"}
         seats = list(self.classroom.seats) if msg.seats == "all" else [int(s) for s in msg.seats]
-        if isinstance(msg, Clock):
+        if isinstance(msg, ClockMessage):
             paused = None if msg.action is None else msg.action == "pause"
             self.classroom.set_clock(seats, paused=paused, speed=msg.speed)
             return {"type": "ok", "message": f"clock of seats {', '.join(map(str, seats))}: "
                                              f"{msg.action or 'speed'} {'' if msg.speed is None else msg.speed}"}
-        if isinstance(msg, Exercise):
+        if isinstance(msg, ExerciseMessage):
             said = self.classroom.start_exercise(seats, msg.name, difficulty=msg.difficulty, seed=msg.seed)
             client.cursor = EventCursor()
             return {"type": "ok", "message": said}
-        if isinstance(msg, Stop):
+        if isinstance(msg, StopMessage):
             written = self.classroom.stop_exercise(seats)
             return {"type": "ok", "message": f"reports written: {', '.join(str(p) for p in written)}" if written
                     else "no exercise on those seats", "reports": [str(p) for p in written]}

@@ -41,7 +41,7 @@ from liansuo.tui.incidents import KEY_PREFIX, Incident
 from liansuo.tui.instructor import InstructorPanel
 from liansuo.tui.layout import Ref
 from liansuo.tui.longrun import LongRun, requested_run
-from liansuo.tui.operate import MODES, Operator, Outcome
+from liansuo.tui.operate import MODES, ConsoleOperator, PressOutcome
 from liansuo.tui.panels import (
     AlarmBell,
     AlarmLine,
@@ -116,7 +116,7 @@ class ConsoleApp(SafeApp):
         super().__init__()
         self.station_ref = station
         self.sim: ConsoleSim = sim if sim is not None else Simulation(station, cycle_s=cycle_s)
-        self.operator = Operator(self.sim)
+        self.operator = ConsoleOperator(self.sim)
         self.paused = paused
         self.speed = speed
         # the instructor's password, kept hashed: given as a hash (a password file), as a password, or in the
@@ -422,7 +422,7 @@ class ConsoleApp(SafeApp):
             return
         self.carry_out(self.operator.press(ref))
 
-    def carry_out(self, out: Outcome) -> None:
+    def carry_out(self, out: PressOutcome) -> None:
         if out.menu is not None:
             kind, element = out.menu
             self.push_screen(MenuScreen(kind, element, self._menu_title(kind, element), self.diagram.cursor_region()),

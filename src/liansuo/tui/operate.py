@@ -66,7 +66,7 @@ MENUS: dict[str, tuple[str, ...]] = {
 
 
 @dataclass
-class Outcome:
+class PressOutcome:
     """What a press leads to: a command to send (perhaps after a question), a menu to open, or just a message."""
 
     command: str = ""
@@ -75,7 +75,7 @@ class Outcome:
     message: str = ""
 
 
-class Operator:
+class ConsoleOperator:
     def __init__(self, sim: ConsoleSim) -> None:
         self.sim = sim
         self.mode: Mode | None = None
@@ -123,12 +123,12 @@ class Operator:
         self.start = None
         self.via = []
 
-    def arm(self, mode: str) -> Outcome:
+    def arm(self, mode: str) -> PressOutcome:
         """A function button: pressing the armed one again disarms it."""
         self.start, self.via = None, []
         if self.mode is not None and self.mode.name == mode:
             self.mode = None
-            return Outcome(message="")
+            return PressOutcome(message="")
         m = MODES[mode]
         if m.target == "station":  # nothing to choose: it asks at once
             self.mode = None
@@ -136,67 +136,67 @@ class Operator:
             if m.sealed:
                 n = self.sim.sealed_uses().get(m.command, 0)
                 count = f" (sealed button 铅封, used {n} time{'' if n == 1 else 's'})"
-            return Outcome(command=m.template, confirm=f"{m.zh} ({m.en}){count}: {m.template}?")
+            return PressOutcome(command=m.template, confirm=f"{m.zh} ({m.en}){count}: {m.template}?")
         self.mode = m
-        return Outcome(message=self.prompt())
+        return PressOutcome(message=self.prompt())
 
     # ---- presses ----
-    def press(self, ref: Ref) -> Outcome:
+    def press(self, ref: Ref) -> PressOutcome:
         if self.mode is not None:
             mode, self.mode = self.mode, None
             return self.apply(mode.name, ref)
         if ref.kind == "button":
             return self._route_button(ref)
         if self.start is not None:
-            return Outcome(message="press an end button to finish the route, or Esc to drop it")
+            return PressOutcome(message="press an end button to finish the route, or Esc to drop it")
         if ref.kind in ("turnout", "section", "signal"):
-            return Outcome(menu=(ref.kind, ref.id))
+            return PressOutcome(menu=(ref.kind, ref.id))
         if ref.kind == "fouling":
-            return Outcome(message=f"fouling point {ref.id} (警冲标)")
+            return PressOutcome(message=f"fouling point {ref.id} (警冲标)")
         if ref.kind == "joint":
             dz = next((d for d in self.sim.station.dead_zones if d.joint == ref.id), None)
             extra = f": dead zone {dz.length:.2f} m (死区段)" if dz else ""
-            return Outcome(message=f"insulated joint {ref.id}{extra}")
+            return PressOutcome(message=f"insulated joint {ref.id}{extra}")
         if ref.kind == "platform":
-            return Outcome(message=f"platform {ref.id}: screen doors {ref.sub}")
+            return PressOutcome(message=f"platform {ref.id}: screen doors {ref.sub}")
         if ref.kind == "block":
             return self._block_button(ref.id, ref.sub)
         if ref.kind == "line":
-            return Outcome(message=f"block line {ref.id}: {self.sim.view.block_line(ref.id) or 'automatic block'}")
-        return Outcome()
+            return PressOutcome(message=f"block line {ref.id}: {self.sim.view.block_line(ref.id) or 'automatic block'}")
+        return PressOutcome()
 
-    def _block_button(self, link: str, button: str) -> Outcome:
+    def _block_button(self, link: str, button: str) -> PressOutcome:
         """A 64D block line's buttons: BSA (闭塞按钮) requests the block, or accepts the neighbour's request;
         FUA (复原按钮) restores it after the arrival, or cancels it before a departure; SGA (事故按钮, sealed)
         forces it back to normal after asking. The interlocking judges each and says why it refuses."""
         state = self.sim.view.block_line(link)
         if button == "BSA":
-            return Outcome(command=f"block-line {link} {'accept' if state == 'asked' else 'request'}")
+            return PressOutcome(command=f"block-line {link} {'accept' if state == 'asked' else 'request'}")
         if button == "FUA":
-            return Outcome(command=f"block-line {link} {'restore' if state == 'arrived' else 'cancel'}")
+            return PressOutcome(command=f"block-line {link} {'restore' if state == 'arrived' else 'cancel'}")
         n = self.sim.sealed_uses().get("block-line accident", 0)
         command = f"block-line {link} accident"
-        return Outcome(command=command, confirm=f"事故 SGA (accident, sealed button 铅封, used {n} time"
+        return PressOutcome(command=command, confirm=f"事故 SGA (accident, sealed button 铅封, used {n} time"
                                                 f"{'' if n == 1 else 's'}): {command}?")
 
-    def apply(self, mode_name: str, ref: Ref) -> Outcome:
+    def apply(self, mode_name: str, ref: Ref) -> PressOutcome:
         """A function applied to an element (from an armed function button or an element's menu)."""
         mode = MODES[mode_name]
         target, why = self._target(mode, ref)
         if not target:
-            return Outcome(message=why)
+            return PressOutcome(message=why)
         template = mode.template
         if mode.name == "guide" and self._guide_route_first(target):
             # no route set and the throat not under guide total lock: the guide route is chosen by its buttons
             self.start, self.via = (target, "guide"), []
-            return Outcome(message=self.prompt())
+            return PressOutcome(message=self.prompt())
         if mode.name == "guide-lock":
             turnouts = self.sim.table.throats.get(target, ())
             if turnouts and all(self.sim.turnout_mark(t) == "guide" for t in turnouts):
                 template = "guide-unlock {}"
         command = template.format(target)
         question = f"{mode.zh} ({mode.en}): {command}?" if mode.confirm else ""
-        return Outcome(command=command, confirm=question)
+        return PressOutcome(command=command, confirm=question)
 
     def _guide_route_first(self, signal: str) -> bool:
         """引导 on a signal with no route set and its throat not under guide total lock: a guide route (引导进路锁闭)
@@ -227,29 +227,29 @@ class Operator:
             return ref.id, ""
         return "", f"{mode.zh}: choose a turnout (its number)"
 
-    def _route_button(self, ref: Ref) -> Outcome:
+    def _route_button(self, ref: Ref) -> PressOutcome:
         if self.start is None:
             if ref.sub not in ("train", "shunt"):
-                return Outcome(message=f"{ref.id} is an end button: a route starts at a signal's train (L) or "
+                return PressOutcome(message=f"{ref.id} is an end button: a route starts at a signal's train (L) or "
                                        "shunting (D) button")
             self.start, self.via = (ref.id, ref.sub), []
-            return Outcome(message=self.prompt())
+            return PressOutcome(message=self.prompt())
         start, kind_word = self.start
         kind: Literal["train", "shunt"] = "shunt" if kind_word == "shunt" else "train"
         if ref.id == start and ref.sub in (kind_word, "train" if kind_word == "guide" else kind_word):
             self.reset()
-            return Outcome(message="route selection dropped")
+            return PressOutcome(message="route selection dropped")
         table = self.sim.table
         if table.by_buttons(kind, start, ref.id, tuple(self.via)) is None and any(
                 r.kind == kind and r.start == start and tuple(r.via[: len(self.via)]) == tuple(self.via)
                 and len(r.via) > len(self.via) and r.via[len(self.via)] == ref.id for r in table.routes.values()):
             self.via.append(ref.id)
-            return Outcome(message=self.prompt())
+            return PressOutcome(message=self.prompt())
         word = {"train": "route", "shunt": "shunt", "guide": "guide"}[kind_word]
         words = [word, start, *self.via, ref.id]
         self.reset()
         if word == "guide":  # a sealed button: counted, and asked before it is given
             n = self.sim.sealed_uses().get("guide", 0)
-            return Outcome(command=" ".join(words), confirm=f"引导 (guide, sealed button 铅封, used {n} time"
+            return PressOutcome(command=" ".join(words), confirm=f"引导 (guide, sealed button 铅封, used {n} time"
                                                             f"{'' if n == 1 else 's'}): {' '.join(words)}?")
-        return Outcome(command=" ".join(words))
+        return PressOutcome(command=" ".join(words))

@@ -311,20 +311,6 @@ class Phase25HzCircuit:
         return hi
 
 
-class Phase25HzTrackRelay:
-    """Stateful JRJC of one section: ``update`` applies the pick-up rule with hysteresis. Starts down (fail-safe)."""
-
-    def __init__(self, circuit: Phase25HzCircuit) -> None:
-        self.circuit = circuit
-        self.up = False
-        self.state: TrackCircuitState | None = None
-
-    def update(self, shunts: Sequence[tuple[float, float]] = (), faults: Phase25HzFaults | None = None) -> bool:
-        self.state = self.circuit.evaluate(shunts, faults)
-        self.up = self.state.relay_up_after(self.up)
-        return self.up
-
-
 _HEALTHY = Phase25HzFaults()
 
 

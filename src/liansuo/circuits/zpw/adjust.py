@@ -54,7 +54,7 @@ FAULT_MODES_CHECKED = ("open", "half", "short")
 
 
 @dataclass(frozen=True)
-class Row:
+class AdjustmentRow:
     """One line of the table: sections of ``layout`` (:data:`.model.LAYOUTS`) and ``carrier`` (base frequency)
     with ``cable_km`` of cable, longer than ``from_m`` up to ``to_m``."""
 
@@ -80,14 +80,15 @@ class AdjustmentTable:
     band_m: float
     max_length_m: float
     cable_km: tuple[float, ...]
-    rows: tuple[Row, ...]
+    rows: tuple[AdjustmentRow, ...]
 
     def ballasts(self, minimum: float) -> tuple[float, ...]:
         """The design ballast range of a layout whose design minimum is ``minimum``, as swept: the minimum, then every
         ballast of the table above it."""
         return (minimum, *(b for b in self.ballasts_ohm_km if b > minimum))
 
-    def row(self, carrier: str, length_m: float, cable_km: float | None = None, layout: str = "conventional") -> Row:
+    def row(self, carrier: str, length_m: float, cable_km: float | None = None,
+            layout: str = "conventional") -> AdjustmentRow:
         """The row of a section; past the table's longest length, the last row of the carrier (not adjustable:
         :func:`check_section` reports it)."""
         base = carrier.partition("-")[0]
@@ -120,8 +121,9 @@ def load_table(path: Path = TABLE_FILE) -> AdjustmentTable:
     """The table as stored (``adjust.yaml`` by default)."""
     root = compose(read_file(path))
     data: dict[str, Any] = build(root).data if root is not None else {}
-    rows = tuple(Row(str(r["layout"]), str(r["carrier"]), float(r["cable_km"]), float(r["from_m"]), float(r["to_m"]),
-                     int(r["level"]), float(r["adjust_mV"]), bool(r["adjustable"])) for r in data["rows"])
+    rows = tuple(AdjustmentRow(str(r["layout"]), str(r["carrier"]), float(r["cable_km"]), float(r["from_m"]),
+                               float(r["to_m"]), int(r["level"]), float(r["adjust_mV"]), bool(r["adjustable"]))
+                 for r in data["rows"])
     return AdjustmentTable(**_settings(data), rows=rows)
 
 
@@ -161,7 +163,7 @@ def derive_table(settings: AdjustmentTable | None = None, params: ZpwParams = DE
     return dataclasses.replace(s, rows=tuple(rows))
 
 
-def _rows(s: AdjustmentTable, layout: str, cable: float, base: str, params: ZpwParams) -> list[Row]:
+def _rows(s: AdjustmentTable, layout: str, cable: float, base: str, params: ZpwParams) -> list[AdjustmentRow]:
     """The rows of one layout, cable length and base carrier, band by band of section length."""
     bands = np.arange(0.0, s.max_length_m, s.band_m)
     return [derive_row(s, layout, cable, base, float(lo), float(min(lo + s.band_m, s.max_length_m)), params)
@@ -169,7 +171,7 @@ def _rows(s: AdjustmentTable, layout: str, cable: float, base: str, params: ZpwP
 
 
 def derive_row(s: AdjustmentTable, layout: str, cable: float, base: str, lo: float, hi: float,
-               params: ZpwParams = DEFAULT_PARAMS) -> Row:
+               params: ZpwParams = DEFAULT_PARAMS) -> AdjustmentRow:
     """The row for sections of ``layout`` and ``base`` carrier (both variants) longer than ``lo`` up to ``hi``,
     every 10 m, over the layout's design ballast range."""
     p = dataclasses.replace(layout_params(layout, base, params), transmitter_V=params.transmitter_levels_V[0])
@@ -185,7 +187,7 @@ def derive_row(s: AdjustmentTable, layout: str, cable: float, base: str, lo: flo
     need = params.cab_min(base) * (1.0 + s.cab_margin)
     level = max((n for n, v in enumerate(params.transmitter_levels_V, start=1)
                  if cab * v / params.transmitter_levels_V[0] >= need), default=1)
-    return Row(layout, base, cable, lo, hi, level, float(adjust), adjustable)
+    return AdjustmentRow(layout, base, cable, lo, hi, level, float(adjust), adjustable)
 
 
 def write_table(path: Path = TABLE_FILE) -> None:
@@ -206,8 +208,8 @@ def write_table(path: Path = TABLE_FILE) -> None:
 
 
 # ---- applying it ---------------------------------------------------------------------------------------------------
-def adjusted_params(carrier: str, length_m: float, cable_km: float | None = None,
-                    params: ZpwParams = DEFAULT_PARAMS, layout: str = "conventional") -> tuple[ZpwParams, Row]:
+def adjusted_params(carrier: str, length_m: float, cable_km: float | None = None, params: ZpwParams = DEFAULT_PARAMS,
+                    layout: str = "conventional") -> tuple[ZpwParams, AdjustmentRow]:
     """``params`` with the figures of the layout and the transmitter level and receiver setting of the section's
     row."""
     row = table().row(carrier, length_m, cable_km, layout)

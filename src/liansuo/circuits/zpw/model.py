@@ -506,20 +506,6 @@ class ZpwCircuit:
         return self.params.cab_min(self.carrier)
 
 
-class ZpwTrackRelay:
-    """Stateful track relay (GJ) of one section: ``update`` applies pick-up / drop. Starts down (fail-safe)."""
-
-    def __init__(self, circuit: ZpwCircuit) -> None:
-        self.circuit = circuit
-        self.up = False
-        self.state: ZpwState | None = None
-
-    def update(self, shunts: Sequence[tuple[float, float]] = (), faults: ZpwFaults | None = None) -> bool:
-        self.state = self.circuit.evaluate(shunts, faults)
-        self.up = self.state.relay_up_after(self.up)
-        return self.up
-
-
 def section_circuit(station: Station, section_id: str, params: ZpwParams = DEFAULT_PARAMS,
                     transmitter_end: End = "upper") -> ZpwCircuit:
     """The ZpwCircuit of a ZPW-2000A section of a station (length, carrier, capacitors from the file, the figures

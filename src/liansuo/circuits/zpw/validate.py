@@ -32,7 +32,7 @@ FAULT_TEXT = {"open": "open", "half": "-50 %"}
 
 
 @dataclass(frozen=True)
-class Section:
+class ArticleSection:
     """One of the article's configurations: an id, the article's name, the length, the kind of ends and the layout
     whose standard figures it has (:data:`.model.LAYOUTS`)."""
 
@@ -59,7 +59,7 @@ class PaperRow:
 class Article:
     """The data file: the configurations, the carriers, the ballast and the table rows."""
 
-    sections: tuple[Section, ...]
+    sections: tuple[ArticleSection, ...]
     carriers: tuple[str, ...]
     ballast_ohm_km: float
     rows: tuple[PaperRow, ...]
@@ -72,8 +72,8 @@ def _pct(value: Any) -> float | None:
 def read_article(path: Path = DATA_FILE) -> Article:
     """The article's configurations and table rows as stored in ``validate.yaml``."""
     data = yaml.safe_load(path.read_text(encoding="utf-8"))
-    sections = tuple(Section(s["id"], s["name"], float(s["length_m"]), s["ends"], s.get("layout", "conventional"))
-                     for s in data["sections"])
+    sections = tuple(ArticleSection(s["id"], s["name"], float(s["length_m"]), s["ends"],
+                                    s.get("layout", "conventional")) for s in data["sections"])
     rows = tuple(PaperRow(int(t["table"]), r["section"], t["fault"], r["quantity"], _pct(r["rise_pct"]),
                           _pct(r["fall_pct"]))
                  for t in data["tables"] for r in t["rows"])
@@ -100,7 +100,7 @@ def trend_ok(paper_rise: float | None, paper_fall: float | None, model_rise: flo
     return True
 
 
-def _changes(section: Section, carriers: Sequence[str], ballast: float) -> dict[str, dict[str, list[float]]]:
+def _changes(section: ArticleSection, carriers: Sequence[str], ballast: float) -> dict[str, dict[str, list[float]]]:
     """Percent change against the healthy section, per fault mode and computed quantity, over every carrier and
     every single faulted capacitor. A conventional section is swept at ``ballast``; a passenger-dedicated one at its
     own design minimum, with its layout's capacitors (which differ by carrier)."""

@@ -54,7 +54,7 @@ ROLE_RANK = {"route": 0, "protection": 1, "driven": 2}
 
 
 @dataclass(frozen=True)
-class Row:
+class SignedRow:
     route: str  # the route id
     cells: dict[str, str]  # column key -> cell
 
@@ -65,7 +65,7 @@ class Group:
     direction: str | None  # down, up; None for the shunting groups
     category: str
     throat: str | None
-    rows: tuple[Row, ...]
+    rows: tuple[SignedRow, ...]
 
 
 @dataclass(frozen=True)
@@ -229,7 +229,7 @@ class _Builder:
             items.append(f"接近锁闭 {' '.join(r.approach)} {release:g}s")
         return "; ".join(items)
 
-    def row(self, n: int, r: Route) -> Row:
+    def row(self, n: int, r: Route) -> SignedRow:
         cells = {
             "no": str(n), "route": self.route_name(r),
             "mode": "变更延续" if r.overlap_alternative else "变通" if r.via else "基本",
@@ -238,7 +238,7 @@ class _Builder:
             "sections": self.sections(r), "enemies": self.enemies(r), "opposing": self.opposing(r),
             "other": self.other(r),
         }
-        return Row(r.id, cells)
+        return SignedRow(r.id, cells)
 
     # ---- the groups ------------------------------------------------------------------------------------------
     def throat(self, r: Route) -> str | None:

@@ -9,6 +9,6 @@ judged by the independent safety oracle at every cycle (docs/explore.md).
 """
 
 from liansuo.proving.explore.actions import Bounds
-from liansuo.proving.explore.search import Expander, Outcome, expand_here, search
+from liansuo.proving.explore.search import Expander, SearchOutcome, expand_here, search
 
-__all__ = ["Bounds", "Expander", "Outcome", "expand_here", "search"]
+__all__ = ["Bounds", "Expander", "SearchOutcome", "expand_here", "search"]

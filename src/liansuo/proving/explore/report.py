@@ -10,7 +10,7 @@ from typing import Any
 import yaml
 
 from liansuo.proving.explore.actions import Bounds
-from liansuo.proving.explore.search import Found, Outcome
+from liansuo.proving.explore.search import Found, SearchOutcome
 
 # what the explored model leaves out or bounds, said with every report (docs/explore.md)
 ABSTRACTIONS = (
@@ -37,7 +37,7 @@ def script(station: str, f: Found) -> str:
     return head + yaml.safe_dump(body, allow_unicode=True, sort_keys=False, width=200)
 
 
-def as_dict(out: Outcome, station: str, asked: int, workers: int, bounds: Bounds, reduce: bool) -> dict[str, Any]:
+def as_dict(out: SearchOutcome, station: str, asked: int, workers: int, bounds: Bounds, reduce: bool) -> dict[str, Any]:
     rate = out.states / out.seconds if out.seconds > 0 else 0.0
     hazards: dict[str, int] = {}
     for f in out.hazards.values():

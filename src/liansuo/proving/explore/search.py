@@ -36,7 +36,7 @@ ANSWER_CYCLES = 12  # after a command or an event, the interlocking answers with
 
 
 @dataclass(frozen=True)
-class Step:
+class TraceStep:
     """One action of a trace: its line as a script writes it, and what the reduction needs of it."""
 
     line: str  # 'run 4.75s' for time
@@ -45,7 +45,7 @@ class Step:
     calm: bool = False  # no timer ran and no machine moved in the state it was done in, and it starts none itself
 
 
-Trace = tuple[Step, ...]
+Trace = tuple[TraceStep, ...]
 
 
 @dataclass
@@ -201,7 +201,7 @@ class Expander:
                 continue
             dirty = True
             out.accepted += 1
-            step = Step(done, action.footprint, action.rank, calm and self.calm())
+            step = TraceStep(done, action.footprint, action.rank, calm and self.calm())
             child = (*trace, step)
             for v in (*self.watch.violations, *self.watch.hazards):
                 out.found.append(Found(v, child))
@@ -211,7 +211,7 @@ class Expander:
         return out
 
 
-def _commute(a: Action, last: Step) -> bool:
+def _commute(a: Action, last: TraceStep) -> bool:
     return "*" not in a.footprint and "*" not in last.footprint and a.footprint.isdisjoint(last.footprint)
 
 
@@ -224,7 +224,7 @@ class Level:
 
 
 @dataclass
-class Outcome:
+class SearchOutcome:
     """What a search found: the findings (each with its shortest trace), the levels, whether it saturated."""
 
     station: str
@@ -244,7 +244,7 @@ PILE = 48  # frontier states in one piece of work
 
 
 def search(station: Station, expand: Expand, root_key: bytes, depth: int, *, budget_s: float | None = None,
-           progress: Callable[[int, int, int, int, float], None] | None = None, first: bool = False) -> Outcome:
+           progress: Callable[[int, int, int, int, float], None] | None = None, first: bool = False) -> SearchOutcome:
     """Breadth first to ``depth``: ``expand(frontier)`` yields the expansions of each pile of ``PILE`` frontier states
     in order (worked in this process or on Dask). Within ``budget_s`` seconds where given: the last level is then
     explored in part, and the outcome says how far. ``first``: stop at the first violation (its sequence is still a
@@ -293,8 +293,8 @@ def search(station: Station, expand: Expand, root_key: bytes, depth: int, *, bud
             saturated = True
             break
         frontier = new
-    return Outcome(station.id, reached, len(seen), transitions, time.monotonic() - start, saturated, levels,
-                   findings, hazards, stopped)
+    return SearchOutcome(station.id, reached, len(seen), transitions, time.monotonic() - start, saturated, levels,
+                         findings, hazards, stopped)
 
 
 def piles(frontier: Sequence[Trace]) -> list[Sequence[Trace]]:
@@ -348,4 +348,4 @@ def expand_on(client: Any, job: Job) -> Expand:
     return expand
 
 
-__all__ = ["GLOBAL", "Expander", "Found", "Outcome", "Step", "Trace", "expand_here", "expand_on", "search"]
+__all__ = ["GLOBAL", "Expander", "Found", "SearchOutcome", "Trace", "TraceStep", "expand_here", "expand_on", "search"]

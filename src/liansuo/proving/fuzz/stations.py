@@ -54,7 +54,7 @@ _RAW_CONTROL = re.compile(r"[\x00-\x08\x0b-\x1f\x7f-\x9f]")
 _DIAGNOSTIC = re.compile(r"^(.+):(\d+):(\d+): error: .+")
 
 
-class Defect(AssertionError):
+class WrongAnswer(AssertionError):
     """The product answered a sample as it must not: the wrong exit status, a refusal without FILE:LINE:COLUMN,
     a file ``check`` accepts and another command refuses, or a raw control character on the terminal."""
 
@@ -273,15 +273,15 @@ def run(*argv: str) -> tuple[int, str, str]:
 def _screen(command: str, out: str, err: str) -> None:
     found = _RAW_CONTROL.search(out + err)
     if found is not None:
-        raise Defect(f"'liansuo {command}' sent the control character {found.group()!r} to the terminal")
+        raise WrongAnswer(f"'liansuo {command}' sent the control character {found.group()!r} to the terminal")
 
 
 def _refusal(command: str, file: Path, code: int, err: str) -> None:
     first = err.splitlines()[0] if err else ""
     m = _DIAGNOSTIC.match(first)
     if code != Exit.BAD_INPUT or m is None or m.group(1) != str(file):
-        raise Defect(f"'liansuo {command}' refused with exit status {code} and {first!r}, not exit status "
-                     f"{int(Exit.BAD_INPUT)} and {file}:LINE:COLUMN: error: ...")
+        raise WrongAnswer(f"'liansuo {command}' refused with exit status {code} and {first!r}, not exit status "
+                          f"{int(Exit.BAD_INPUT)} and {file}:LINE:COLUMN: error: ...")
 
 
 def attempt(sample: StationSample) -> str:
@@ -300,6 +300,6 @@ def attempt(sample: StationSample) -> str:
             code, out, err = run(*command, str(file))
             _screen(command[0], out, err)
             if code not in (Exit.OK, Exit.FAILED):  # verify's failed checks are an answer about the station
-                raise Defect(f"'liansuo check' accepted the file, 'liansuo {command[0]}' exits {code}: "
-                             f"{err.splitlines()[:1]}")
+                raise WrongAnswer(f"'liansuo check' accepted the file, 'liansuo {command[0]}' exits {code}: "
+                                  f"{err.splitlines()[:1]}")
         return "accepted"

@@ -67,7 +67,7 @@ class Claim:
 
 
 @dataclass
-class Hold:
+class OverlapHold:
     """Sections that must stay locked until ``until`` (an overlap behind a received train)."""
 
     what: str
@@ -78,7 +78,7 @@ class Hold:
 @dataclass
 class JudgeMemory:
     claims: dict[str, Claim] = field(default_factory=dict)
-    holds: list[Hold] = field(default_factory=list)
+    holds: list[OverlapHold] = field(default_factory=list)
     powered_up: bool = False  # since a restart, until the power-up release
     locked: set[str] = field(default_factory=set)  # sections shown locked at the last check
     commanded: bool = False  # a command that releases by hand was accepted since the last check
@@ -88,7 +88,7 @@ class JudgeMemory:
     occupied_before: frozenset[str] = frozenset()
 
 
-class Tables:
+class JudgeTables:
     """What the judge reads of a station and rule set, once."""
 
     def __init__(self, station: Station, rules: RuleSet) -> None:
@@ -119,7 +119,7 @@ class Judge:
         self.st = station
         self.rules = rules
         self.reaction = reaction
-        self.tables = station.derived(Tables, rules)
+        self.tables = station.derived(JudgeTables, rules)
         self.memory = JudgeMemory()
 
     def busy(self) -> bool:
@@ -305,7 +305,8 @@ class Judge:
         found = self.tables.overlaps.get((c.signal, c.end_signal))
         if found is not None and all(view.section_locked(s) for s in found[0]):  # (one never locked: verify's)
             sections, time = found
-            self.memory.holds.append(Hold(f"the overlap of {c.signal} beyond {c.end_signal}", sections, now + time))
+            hold = OverlapHold(f"the overlap of {c.signal} beyond {c.end_signal}", sections, now + time)
+            self.memory.holds.append(hold)
 
     # ---- helpers -----------------------------------------------------------------------------------------------
     def _occupied(self, view: FieldView) -> frozenset[str]:

@@ -35,7 +35,7 @@ from liansuo.stations.station import Station
 
 
 @dataclass(frozen=True)
-class Limit:
+class AspectLimit:
     aspect: str  # the most permissive aspect allowed
     why: str
 
@@ -50,11 +50,11 @@ def permits(limit: str, shown: str, aspects: Aspects) -> bool:
     return aspects.rank_of(shown) < aspects.rank_of(limit)
 
 
-def follow(ahead: str, signal_ahead: str, aspects: Aspects) -> Limit:
+def follow(ahead: str, signal_ahead: str, aspects: Aspects) -> AspectLimit:
     if ahead in (DARK, UNDEFINED):
-        return Limit(aspects.stop, f"signal {signal_ahead} ahead is dark")
+        return AspectLimit(aspects.stop, f"signal {signal_ahead} ahead is dark")
     most = aspects.rear.get(ahead, aspects.caution)
-    return Limit(most, f"{signal_ahead} ahead shows {ahead}")
+    return AspectLimit(most, f"{signal_ahead} ahead shows {ahead}")
 
 
 class Ceiling:
@@ -73,13 +73,13 @@ class Ceiling:
         self.diverging = next(d for d in self.a.diverging if d not in self.a.flashing)
         self.diverging_flashing = next((d for d in self.a.diverging if d in self.a.flashing), self.diverging)
 
-    def of(self, a: Authority, view: FieldView, ahead: str, ahead_path: Authority | None) -> Limit:
+    def of(self, a: Authority, view: FieldView, ahead: str, ahead_path: Authority | None) -> AspectLimit:
         """The ceiling for authority ``a``; ``ahead`` is the aspect its end signal shows (as read from its lamps)
         and ``ahead_path`` that signal's own authority when it is open."""
         if a.kind == "shunt":
-            return Limit(self.a.shunt, "shunting")
+            return AspectLimit(self.a.shunt, "shunting")
         if a.end in ("broken", "loop"):
-            return Limit(self.a.stop, "the path cannot be traced")
+            return AspectLimit(self.a.stop, "the path cannot be traced")
         sig = self.st.signals[a.signal]
         if sig.kind in (SignalKind.home, SignalKind.route):
             reverse = [t for t, pos in a.turnouts.items() if pos == "reverse"]
@@ -90,40 +90,40 @@ class Ceiling:
         if a.end == "boundary" and a.link is not None and sig.kind is not SignalKind.block:
             return self._line(a, view)
         if a.end == "buffer":
-            return Limit(self.a.caution, "the path ends at a buffer stop")
-        return Limit(self.a.clear, "the path leaves the station model with no block line to judge")
+            return AspectLimit(self.a.caution, "the path ends at a buffer stop")
+        return AspectLimit(self.a.clear, "the path leaves the station model with no block line to judge")
 
-    def _diverging(self, a: Authority, reverse: list[str], ahead: str, ahead_path: Authority | None) -> Limit:
+    def _diverging(self, a: Authority, reverse: list[str], ahead: str, ahead_path: Authority | None) -> AspectLimit:
         most, flashing = self.diverging, self.diverging_flashing
         small = [t for t in reverse if self.speed[t] < self.usu_min]
         if small:
-            return Limit(most, f"diverging over turnout {small[0]} ({self.speed[small[0]]:g} km/h)")
+            return AspectLimit(most, f"diverging over turnout {small[0]} ({self.speed[small[0]]:g} km/h)")
         if not self.st.signals[a.signal].usu:
-            return Limit(most, f"diverging; {a.signal} has no flashing yellow")
+            return AspectLimit(most, f"diverging; {a.signal} has no flashing yellow")
         if ahead not in self.a.train_proceed or ahead_path is None:
-            return Limit(most, f"diverging; the next signal {a.end_signal or '-'} is not open")
+            return AspectLimit(most, f"diverging; the next signal {a.end_signal or '-'} is not open")
         onward = [t for t, pos in ahead_path.turnouts.items()
                   if pos == "reverse" and self.speed[t] < self.usu_min]
         if onward:
-            return Limit(most, f"the next signal {a.end_signal} is open over turnout {onward[0]} reversed "
+            return AspectLimit(most, f"the next signal {a.end_signal} is open over turnout {onward[0]} reversed "
                                f"({self.speed[onward[0]]:g} km/h)")
-        return Limit(flashing, f"diverging over turnouts for {self.usu_min:g} km/h, {a.end_signal} open straight "
+        return AspectLimit(flashing, f"diverging over turnouts for {self.usu_min:g} km/h, {a.end_signal} open straight "
                                f"or over such turnouts")
 
-    def _line(self, a: Authority, view: FieldView) -> Limit:
+    def _line(self, a: Authority, view: FieldView) -> AspectLimit:
         assert a.link is not None
         lk = self.links[a.link]
         if lk.kind.value == "64d":
             if view.line_permits(lk.id):
-                return Limit(self.semi_auto, f"64D line {lk.id} accepted by the neighbour")
-            return Limit(self.a.stop, f"64D line {lk.id} has not been accepted by the neighbour station")
+                return AspectLimit(self.semi_auto, f"64D line {lk.id} accepted by the neighbour")
+            return AspectLimit(self.a.stop, f"64D line {lk.id} has not been accepted by the neighbour station")
         if lk.kind.value == "station":  # one block section to the neighbour, proven clear by its axle counters
             if not view.line_permits(lk.id):
-                return Limit(self.a.stop, f"station-block line {lk.id} is blocked by the neighbour for its train")
+                return AspectLimit(self.a.stop, f"station-block line {lk.id} is blocked by the neighbour for its train")
             occupied = [s for s in lk.sections if not view.clear(s)]
             if occupied:
-                return Limit(self.a.stop, f"station-block line {lk.id}: {occupied[0]} shows occupied")
-            return Limit(self.semi_auto, f"station-block line {lk.id} clear and not blocked by the neighbour")
+                return AspectLimit(self.a.stop, f"station-block line {lk.id}: {occupied[0]} shows occupied")
+            return AspectLimit(self.semi_auto, f"station-block line {lk.id} clear and not blocked by the neighbour")
         clear = 0
         for s in lk.sections:
             if not view.clear(s):
@@ -131,13 +131,13 @@ class Ceiling:
             clear += 1
         if self.st.link_running(lk.id) == "inbound":
             if not view.line_outbound(lk.id):
-                return Limit(self.a.stop, f"line {lk.id} runs towards this station: a departure onto it needs a "
+                return AspectLimit(self.a.stop, f"line {lk.id} runs towards this station: a departure onto it needs a "
                                           "direction change (改方)")
             if clear < len(lk.sections):
-                return Limit(self.a.stop, f"line {lk.id} worked against its running direction is one block, not all "
-                                          "clear")
-            return Limit(self.a.clear, f"line {lk.id} set for departures and clear")
+                return AspectLimit(self.a.stop, f"line {lk.id} worked against its running direction is one block, "
+                                                "not all clear")
+            return AspectLimit(self.a.clear, f"line {lk.id} set for departures and clear")
         steps = self.a.automatic_block
         aspect = steps[min(clear, len(steps) - 1)]
-        return Limit(aspect, f"{clear} clear block section(s) on line {lk.id}")
+        return AspectLimit(aspect, f"{clear} clear block section(s) on line {lk.id}")
 

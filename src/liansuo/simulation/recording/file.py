@@ -33,12 +33,12 @@ from liansuo.simulation.recording.schema import (
     MAX_LINE_CHARS,
     RECORD,
     VERSION,
-    Chg,
-    Cmd,
-    Cyc,
-    End,
-    Header,
-    Init,
+    ChgRecord,
+    CmdRecord,
+    CycRecord,
+    EndRecord,
+    HeaderRecord,
+    InitRecord,
 )
 from liansuo.stations.library import LIBRARY, bundled
 from liansuo.stations.loader import load
@@ -59,13 +59,13 @@ class Recording:
     """A recording that passed every check of :func:`load_recording`; each record with its line in the file."""
 
     path: str
-    header: Header
-    init: Init
-    end: End
+    header: HeaderRecord
+    init: InitRecord
+    end: EndRecord
     end_line: int
-    commands: list[tuple[int, Cmd]]  # (line, record), in the order sent
-    cycles_changed: dict[int, tuple[int, Cyc]]  # cycle -> (line, record)
-    changes: dict[int, tuple[int, Chg]]  # command number -> (line, the record of what it changed)
+    commands: list[tuple[int, CmdRecord]]  # (line, record), in the order sent
+    cycles_changed: dict[int, tuple[int, CycRecord]]  # cycle -> (line, record)
+    changes: dict[int, tuple[int, ChgRecord]]  # command number -> (line, the record of what it changed)
     cycle_lines: list[tuple[int, int]]  # (cycle, line) of every record after the header, for a cycle's line
 
     @property
@@ -225,30 +225,30 @@ def _record_errors(file: str, line: int, exc: ValidationError) -> list[Diagnosti
 
 def _assemble(file: str, entries: list[tuple[int, Any]]) -> Recording:
     """The records in their places, or the first problem with their order, numbering or times."""
-    if not entries or not isinstance(entries[0][1], Header):
+    if not entries or not isinstance(entries[0][1], HeaderRecord):
         raise _error(file, entries[0][0] if entries else 1, "the first record is the header",
                      f"a recording starts with {{\"k\": \"header\", \"format\": \"{FORMAT}\", ...}}")
-    header: Header = entries[0][1]
-    if len(entries) < 2 or not isinstance(entries[1][1], Init):
+    header: HeaderRecord = entries[0][1]
+    if len(entries) < 2 or not isinstance(entries[1][1], InitRecord):
         line = entries[1][0] if len(entries) > 1 else entries[0][0]
         what = "has only its header" if len(entries) < 2 else f"has a '{entries[1][1].k}' record second"
         raise _error(file, line, f"the recording {what}: its 'init' record (the state when recording started) is "
                                  "missing, so there is nothing to replay", RECORD_AGAIN)
-    init: Init = entries[1][1]
+    init: InitRecord = entries[1][1]
     last_line, last = entries[-1]
-    if not isinstance(last, End):
+    if not isinstance(last, EndRecord):
         raise _error(file, last_line, "the recording has no 'end' record after this line: it was cut short (the "
                                       "console was killed or did not close the file), so its length is unknown",
                      RECORD_AGAIN)
-    commands: list[tuple[int, Cmd]] = []
-    cycles_changed: dict[int, tuple[int, Cyc]] = {}
-    changes: dict[int, tuple[int, Chg]] = {}
+    commands: list[tuple[int, CmdRecord]] = []
+    cycles_changed: dict[int, tuple[int, CycRecord]] = {}
+    changes: dict[int, tuple[int, ChgRecord]] = {}
     cycle_lines: list[tuple[int, int]] = []
     n_before, line_before = 0, entries[1][0]
     for line, rec in entries[2:]:
-        if isinstance(rec, Header | Init):
+        if isinstance(rec, HeaderRecord | InitRecord):
             raise _error(file, line, f"a second '{rec.k}' record", "a recording has one header and one init record")
-        if isinstance(rec, End) and line != last_line:
+        if isinstance(rec, EndRecord) and line != last_line:
             raise _error(file, line, "an 'end' record before the last line", "nothing follows the end record")
         if rec.n < n_before:
             raise _error(file, line, f"cycle {rec.n} after cycle {n_before} (line {line_before}): records are in "
@@ -259,23 +259,23 @@ def _assemble(file: str, entries: list[tuple[int, Any]]) -> Recording:
                                      f"{header.cycle_s:g} s a cycle from t0 = {header.t0:g} s)", "the file is damaged")
         n_before, line_before = rec.n, line
         cycle_lines.append((rec.n, line))
-        if isinstance(rec, Cmd):
+        if isinstance(rec, CmdRecord):
             if rec.i != len(commands) + 1:
                 raise _error(file, line, f"command number {rec.i} where {len(commands) + 1} was next: a command "
                                          "record is missing or repeated", "the file is damaged")
             commands.append((line, rec))
-        elif isinstance(rec, Cyc):
+        elif isinstance(rec, CycRecord):
             if rec.n in cycles_changed:
                 raise _error(file, line, f"a second record of cycle {rec.n} (the first at line "
                                          f"{cycles_changed[rec.n][0]})", "the file is damaged")
             cycles_changed[rec.n] = (line, rec)
-        elif isinstance(rec, Chg):
+        elif isinstance(rec, ChgRecord):
             owner = len(commands)
             if not owner or owner in changes:
                 raise _error(file, line, "a 'chg' record that follows no command (it holds what the command before "
                                          "it changed)", "the file is damaged")
             changes[owner] = (line, rec)
-    end: End = last
+    end: EndRecord = last
     if end.cmds != len(commands):
         raise _error(file, last_line, f"the end record counts {end.cmds} commands, the file holds {len(commands)}: "
                                       "a command record is missing or one too many", "the file is damaged")

@@ -20,7 +20,7 @@ from liansuo.interlocking.io import Result
 from liansuo.kit.printable import printable
 from liansuo.simulation.recording.file import Recording, recording_station
 from liansuo.simulation.recording.recorder import Recorder, State, diff
-from liansuo.simulation.recording.schema import Cmd, state_of
+from liansuo.simulation.recording.schema import CmdRecord, state_of
 from liansuo.simulation.sim import Simulation
 from liansuo.stations.station import Station
 
@@ -33,7 +33,7 @@ class Played:
     """A recorded command as replayed: what it answered then and now."""
 
     file_line: int
-    cmd: Cmd
+    cmd: CmdRecord
     ok_now: bool
     msg_now: str
 
@@ -149,7 +149,7 @@ class Replayer:
                 return
             self.sim.step()
 
-    def _send(self, line: int, cmd: Cmd) -> None:
+    def _send(self, line: int, cmd: CmdRecord) -> None:
         self.recorder.source = cmd.by
         self._current = cmd.i
         try:

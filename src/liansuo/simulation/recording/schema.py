@@ -54,7 +54,7 @@ class _Record(BaseModel):
     model_config = ConfigDict(extra="forbid", strict=True, allow_inf_nan=False, populate_by_name=True)
 
 
-class Inputs(_Record):
+class InputsRecord(_Record):
     """Relay inputs of the interlocking: all of them in ``init``, what changed in ``cyc`` and ``chg``."""
 
     gj: dict[Id, bool] = Field(default_factory=dict, description="track relays: true when the section is clear")
@@ -64,7 +64,7 @@ class Inputs(_Record):
     pd: dict[Id, tuple[bool, bool]] = Field(default_factory=dict, description="platform:side -> [PDKJ, PDQCJ]")
 
 
-class Outputs(_Record):
+class OutputsRecord(_Record):
     """Outputs of the interlocking, and the section states the console shows."""
 
     sig: dict[Id, Value] = Field(default_factory=dict, description="aspects")
@@ -72,7 +72,7 @@ class Outputs(_Record):
     sec: dict[Id, Value] = Field(default_factory=dict, description="section states")
 
 
-class Header(_Record):
+class HeaderRecord(_Record):
     """Line 1: what the recording is and the station it was made on."""
 
     k: Literal["header"]
@@ -87,17 +87,17 @@ class Header(_Record):
     t0: Time = Field(description="simulated time when the recording started")
 
 
-class Init(_Record):
+class InitRecord(_Record):
     """Line 2: every relay input and output when the recording started."""
 
     k: Literal["init"]
     n: Literal[0]
     t: Time
-    in_: Inputs = Field(alias="in")
-    out: Outputs
+    in_: InputsRecord = Field(alias="in")
+    out: OutputsRecord
 
 
-class Cmd(_Record):
+class CmdRecord(_Record):
     """A command and its answer, in the order sent; ``i`` numbers them from 1, so none can go missing unseen."""
 
     k: Literal["cmd"]
@@ -110,27 +110,27 @@ class Cmd(_Record):
     by: str = Field(max_length=MAX_ID_CHARS, description="who sent it: trainee, instructor, exercise, console ...")
 
 
-class Cyc(_Record):
+class CycRecord(_Record):
     """What a cycle changed (cycles that change nothing are not written)."""
 
     k: Literal["cyc"]
     n: Annotated[int, Field(ge=1, le=MAX_CYCLES)]
     t: Time
-    in_: Inputs | None = Field(None, alias="in")
-    out: Outputs | None = None
+    in_: InputsRecord | None = Field(None, alias="in")
+    out: OutputsRecord | None = None
 
 
-class Chg(_Record):
+class ChgRecord(_Record):
     """What the command just before it changed without a cycle (a fault, a turnout thrown ...)."""
 
     k: Literal["chg"]
     n: Cycle
     t: Time
-    in_: Inputs | None = Field(None, alias="in")
-    out: Outputs | None = None
+    in_: InputsRecord | None = Field(None, alias="in")
+    out: OutputsRecord | None = None
 
 
-class End(_Record):
+class EndRecord(_Record):
     """The last line: how long the session ran and how many commands it sent."""
 
     k: Literal["end"]
@@ -139,12 +139,12 @@ class End(_Record):
     cmds: int = Field(ge=0, description="the number of cmd records")
 
 
-Record = Header | Init | Cmd | Cyc | Chg | End
+Record = HeaderRecord | InitRecord | CmdRecord | CycRecord | ChgRecord | EndRecord
 RECORD: TypeAdapter[Record] = TypeAdapter(Annotated[Record, Field(discriminator="k")])
 KINDS = ("header", "init", "cmd", "cyc", "chg", "end")
 
 
-def state_of(record: Init | Cyc | Chg) -> dict[str, dict[str, dict[str, object]]]:
+def state_of(record: InitRecord | CycRecord | ChgRecord) -> dict[str, dict[str, dict[str, object]]]:
     """The record's ``in`` and ``out`` as the recorder wrote them (only the groups it holds)."""
     out: dict[str, dict[str, dict[str, object]]] = {}
     for side, part in (("in", record.in_), ("out", record.out)):

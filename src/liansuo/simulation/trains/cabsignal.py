@@ -39,7 +39,7 @@ from liansuo.circuits.leakage import LongDeadZone
 from liansuo.circuits.trackcircuits import SectionCircuit
 from liansuo.circuits.zpw.model import End, ZpwCircuit
 from liansuo.simulation.trains.consist import Consist
-from liansuo.simulation.trains.movement import Position, Track
+from liansuo.simulation.trains.movement import Position, TrackGeometry
 from liansuo.stations.schema import Direction
 from liansuo.stations.station import Station
 from liansuo.stations.topology import Move
@@ -97,7 +97,7 @@ class Cabbed(Protocol):
 class CabReader:
     """Reads every train's cab signal from the field."""
 
-    def __init__(self, station: Station, fld: Field, track: Track, zones: dict[str, list[LongDeadZone]],
+    def __init__(self, station: Station, fld: Field, track: TrackGeometry, zones: dict[str, list[LongDeadZone]],
                  wheel_ohm: float) -> None:
         self.station = station
         self.field = fld

@@ -14,7 +14,7 @@ from collections.abc import Mapping
 from math import sqrt
 
 from liansuo.rules import RuleSet
-from liansuo.simulation.trains.movement import OUTSIDE, Position, Track
+from liansuo.simulation.trains.movement import OUTSIDE, Position, TrackGeometry
 from liansuo.stations.schema import Direction, EndKind, Signal, SignalKind
 from liansuo.stations.station import Station
 
@@ -58,8 +58,8 @@ class Lookout:
         return at
 
 
-def aim(track: Track, pos: Position, aspects: Mapping[str, str], lookout: Lookout, horizon: float, margin: float,
-        shunting: bool, boundary_stops: bool, current_limit_ms: float, vmax_ms: float, brake_ms2: float,
+def aim(track: TrackGeometry, pos: Position, aspects: Mapping[str, str], lookout: Lookout, horizon: float,
+        margin: float, shunting: bool, boundary_stops: bool, current_limit_ms: float, vmax_ms: float, brake_ms2: float,
         lead_m: float) -> tuple[float, str]:
     """The speed a driver aims for now: the lowest of line speed, the current aspect's limit, and what lets the train
     meet every limit ahead (signals, a buffer stop, the boundary when ``boundary_stops``) along the rails as they lie

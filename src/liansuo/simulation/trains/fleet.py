@@ -22,7 +22,7 @@ from liansuo.simulation.trains.cabsignal import ATP, CabReader, CabReading, CabS
 from liansuo.simulation.trains.consist import Consist
 from liansuo.simulation.trains.drivers import Lookout, aim, stopping_speed
 from liansuo.simulation.trains.engine import KinematicEngine, MotionEngine
-from liansuo.simulation.trains.movement import OUTSIDE, Notify, Position, Track
+from liansuo.simulation.trains.movement import OUTSIDE, Notify, Position, TrackGeometry
 from liansuo.simulation.trains.odometerfeed import OdometerFeed
 from liansuo.simulation.trains.traction import leaking_sections
 from liansuo.simulation.trains.wheelsets import TrainWheelsets, wheelsets_now
@@ -120,7 +120,7 @@ class Fleet:
         self.engine: MotionEngine = engine or KinematicEngine()
         self.station = station
         self.field = fld
-        self.track = Track(station, fld)
+        self.track = TrackGeometry(station, fld)
         self.lookout = Lookout(station, self.rules)  # what drivers look out for, sorted out once
         # long dead zones by track, balises and RFID tags by track: read only, shared by every fleet of the station
         self.long_zones, self.tags = station.derived(_lineside, self.rules)

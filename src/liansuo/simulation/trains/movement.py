@@ -42,7 +42,7 @@ class RailsAhead:
 
     __slots__ = ("consulted", "ended", "lengths", "moves", "nodes", "track")
 
-    def __init__(self, track: Track, front: Move, length: float, node: str | None) -> None:
+    def __init__(self, track: TrackGeometry, front: Move, length: float, node: str | None) -> None:
         self.track = track  # whose field's turnouts it follows
         self.moves = [front]
         self.lengths = [length]
@@ -50,7 +50,7 @@ class RailsAhead:
         self.consulted: list[tuple[SwitchMachine, str | None]] = []  # (machine, where its rails lay)
         self.ended = front[0] == OUTSIDE  # no move after the last one (a buffer stop, the open line, no position)
 
-    def holds(self, track: Track, front: Move) -> bool:
+    def holds(self, track: TrackGeometry, front: Move) -> bool:
         if self.track is not track or self.moves[0] != front:
             return False
         return not self.consulted or all(machine.rails == rails for machine, rails in self.consulted)
@@ -60,7 +60,7 @@ def _track_geo(station: Station) -> dict[str, tuple[float, float, float]]:
     return {t: (*station.track_span(t), station.track_length(t)) for t in station.tracks}
 
 
-class Track:
+class TrackGeometry:
     """Geometry queries shared by all trains of a station."""
 
     def __init__(self, station: Station, fld: Field) -> None:

@@ -15,7 +15,7 @@ from typing import Protocol
 
 from liansuo.circuits.leakage import LongDeadZone
 from liansuo.simulation.trains.consist import Consist
-from liansuo.simulation.trains.movement import Position, Track
+from liansuo.simulation.trains.movement import Position, TrackGeometry
 
 
 class Drawing(Protocol):
@@ -27,7 +27,7 @@ class Drawing(Protocol):
     consist: Consist
 
 
-def leaking_sections(track: Track, zones: dict[str, list[LongDeadZone]], trains: Iterable[Drawing]) -> set[str]:
+def leaking_sections(track: TrackGeometry, zones: dict[str, list[LongDeadZone]], trains: Iterable[Drawing]) -> set[str]:
     """The sections the ``trains`` leak traction current into now, through the long dead ``zones`` (by track)."""
     out: set[str] = set()
     tracks = track.station.tracks

@@ -16,7 +16,7 @@ from itertools import pairwise
 
 from liansuo.circuits.railgeometry import RailGeometry
 from liansuo.circuits.shunts import Shunt
-from liansuo.simulation.trains.movement import OUTSIDE_LENGTH, Position, Track
+from liansuo.simulation.trains.movement import OUTSIDE_LENGTH, Position, TrackGeometry
 from liansuo.stations.schema import Direction
 from liansuo.stations.topology import Move
 
@@ -44,7 +44,7 @@ class Footprint:
         return offsets is self.offsets and self.from_s <= pos.front_s < self.until_s and pos.moves == self.moves
 
 
-def footprint(track: Track, pos: Position, offsets: tuple[float, ...], geometry: RailGeometry,
+def footprint(track: TrackGeometry, pos: Position, offsets: tuple[float, ...], geometry: RailGeometry,
               was: Footprint | None = None) -> Footprint:
     """The sections the train at ``pos`` shunts, and how far they hold (``was``: the train's previous footprint)."""
     moves = list(pos.moves)
@@ -57,7 +57,7 @@ def footprint(track: Track, pos: Position, offsets: tuple[float, ...], geometry:
     return Footprint(moves, offsets, True, sections, pos.front_s, pos.front_s + slack - EDGE_M)
 
 
-def sections_shunted(track: Track, pos: Position, offsets: tuple[float, ...], geometry: RailGeometry
+def sections_shunted(track: TrackGeometry, pos: Position, offsets: tuple[float, ...], geometry: RailGeometry
                      ) -> tuple[frozenset[str], float]:
     """The sections where at least one wheelset (``offsets`` behind the front, in increasing order) shunts, exactly
     those of ``Track.shunts``, and how far the front can run on over the same moves before that can change: before
@@ -184,7 +184,7 @@ class TrainWheelsets:
 
     __slots__ = ("_by_section", "_front_s", "_geometry", "_track", "footprint", "max_ohm")
 
-    def __init__(self, track: Track, geometry: RailGeometry, front_s: float, fp: Footprint, ohm: float) -> None:
+    def __init__(self, track: TrackGeometry, geometry: RailGeometry, front_s: float, fp: Footprint, ohm: float) -> None:
         self._track = track
         self._geometry = geometry
         self._front_s = front_s
@@ -209,7 +209,7 @@ class TrainWheelsets:
         return self._by_section.get(section, [])
 
 
-def wheelsets_now(track: Track, geometry: RailGeometry, was: TrainWheelsets | None, pos: Position,
+def wheelsets_now(track: TrackGeometry, geometry: RailGeometry, was: TrainWheelsets | None, pos: Position,
                   offsets: tuple[float, ...], ohm: float) -> TrainWheelsets:
     """A train's wheelsets where it stands now: ``was`` if it has not moved, its sections worked out again only
     if they can have changed."""
