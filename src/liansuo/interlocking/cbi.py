@@ -29,8 +29,8 @@ class Interlocking:
     skip_quiet = True  # run no cycle while the interlocking is at rest (quiet.py); tests switch it off
 
     def __init__(self, table: InterlockingTable, rules: RuleSet | None = None, cycle_s: float = 0.25, *,
-                 locked_at_start: bool = False) -> None:
-        self.core = Core(table, rules, cycle_s, locked_at_start=locked_at_start)
+                 locked_at_start: bool = False, now: float = 0.0) -> None:
+        self.core = Core(table, rules, cycle_s, locked_at_start=locked_at_start, now=now)
         self.lifecycle = RouteLifecycle(self.core)
         self._operator = Operator(self.core, self.lifecycle)
         self.quiet: Quiet | None = None  # at rest after the last cycle: until when (quiet.py)
@@ -41,12 +41,16 @@ class Interlocking:
         self.quiet = None
         return self._operator
 
+    def rest(self, cycles: int, t: float) -> None:
+        """``cycles`` cycles at rest, the last at ``t``, that the world ran in one go: each would have found the
+        interlocking quiet (:mod:`.quiet`: no relay changed, no command, no timer ran out), so only its clock moves."""
+        self.core.tick(t, cycles)
+
     def cycle(self, t: float) -> Outputs:
         core = self.core
         quiet = self.quiet
         if quiet is not None and self.skip_quiet and not core.board.pending() and quiet.holds(t):
-            core.now = t
-            core.cycles += 1
+            core.tick(t)
             return core.out
         before = CycleMark.of(core)
         changes = core.take_inputs(t)

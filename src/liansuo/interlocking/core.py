@@ -80,14 +80,14 @@ class Core:
     and every signal closed until the operator's power-up release."""
 
     def __init__(self, table: InterlockingTable, rules: RuleSet | None = None, cycle_s: float = 0.25, *,
-                 locked_at_start: bool = False) -> None:
+                 locked_at_start: bool = False, now: float = 0.0) -> None:
         self.table = table
         self.station: Station = table.station
         self.rules = rules or load_rules()
         self.cycle_s = cycle_s
         self.board = RelayBoard()
         self.out = Outputs()
-        self.now = 0.0
+        self.now = now  # moved only by tick()
         self.cycles = 0
         # the relays that changed, as the last cycle took them: what the routes' memos (lifecycle) are checked against
         self.changes = Changes(set(), set(), set(), set(), {}, False)
@@ -152,9 +152,13 @@ class Core:
         return self.board.clear(section)
 
     # ---- the cycle: inputs before the routes, outputs after them ----------------------------------------------
-    def take_inputs(self, t: float) -> Changes:
+    def tick(self, t: float, cycles: int = 1) -> None:
+        """The clock, and the one place it moves: ``cycles`` more cycles have run, the last at ``t``."""
         self.now = t
-        self.cycles += 1
+        self.cycles += cycles
+
+    def take_inputs(self, t: float) -> Changes:
+        self.tick(t)
         # aspects set since the last cycle's chain update (by operator commands: cancel, reopen, guide) still have to
         # reach the automatic block signals in rear
         commanded = bool(self.out.changed_signals)

@@ -105,8 +105,8 @@ class World:
             t, k = nt, k + 1
         if k:
             self.field.rest(self.cycle_s, k)
-            self.t = self.neighbours.t = il.core.now = t
-            il.core.cycles += k
+            self.t = self.neighbours.t = t
+            il.rest(k, t)
         return k
 
     def run(self, seconds: float) -> None:
@@ -122,8 +122,7 @@ class World:
         """The interlocking loses power and starts again (全站停电恢复): every route and lock is forgotten, every signal
         closes, and the station stays locked (上电锁闭) until the operator's power-up release. The field keeps what
         it had: turnouts lie where they lay, trains stay where they are."""
-        self.interlocking = Interlocking(self.table, self.rules, self.cycle_s, locked_at_start=True)
-        self.interlocking.core.now = self.t
+        self.interlocking = Interlocking(self.table, self.rules, self.cycle_s, locked_at_start=True, now=self.t)
         self.view = InterlockingView(self.interlocking)
         self.wiring.relight()
         self.wiring.publish(self.view.inputs, everything=True)
