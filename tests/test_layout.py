@@ -88,3 +88,21 @@ def test_imports_point_down_and_close_no_circle() -> None:
     assert not up, "imports that do not point down:\n" + "\n".join(up)
     circles = [" -> ".join(c) for c in nx.simple_cycles(graph)]
     assert not circles, "modules that import each other:\n" + "\n".join(circles)
+
+
+def test_nothing_of_the_simulated_station_reads_the_wall_clock() -> None:
+    """Time is injected (docs/architecture.md): the front ends pace the world, proving and bench time their runs."""
+    station_layers = ("kit", "rules", "stations", "circuits", "interlocking", "simulation", "classroom")
+    clocks = {"monotonic", "perf_counter", "time", "time_ns", "sleep", "now", "utcnow", "today"}
+    found = []
+    for layer in station_layers:
+        for path in (PKG / layer).rglob("*.py"):
+            tree = ast.parse(path.read_text(encoding="utf-8"))
+            for node in ast.walk(tree):
+                if isinstance(node, ast.Attribute) and node.attr in clocks and isinstance(node.value, ast.Name) \
+                        and node.value.id in ("time", "datetime", "date"):
+                    found.append(f"{path.relative_to(PKG)}:{node.lineno}: {node.value.id}.{node.attr}")
+                if isinstance(node, ast.ImportFrom) and node.module in ("time", "datetime"):
+                    found += [f"{path.relative_to(PKG)}:{node.lineno}: from {node.module} import {a.name}"
+                              for a in node.names if a.name in clocks | {"datetime"}]
+    assert not found, "the wall clock read below the front ends:\n" + "\n".join(found)

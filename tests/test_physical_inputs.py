@@ -13,8 +13,9 @@ from conftest import Driver, edit
 
 from liansuo.circuits.phase25.model import MAX_LENGTH_M, Phase25HzCircuit, Phase25HzFaults, Phase25HzParams
 from liansuo.circuits.railgeometry import Axle
-from liansuo.circuits.zpw.model import ZpwCircuit, ZpwFaults, standard_positions, sweep
+from liansuo.circuits.zpw.model import ZpwCircuit, ZpwFaults, standard_positions
 from liansuo.circuits.zpw.params import ZpwParams
+from liansuo.circuits.zpw.sweep import sweep
 from liansuo.cli.main import main
 from liansuo.simulation.sim import Simulation
 

@@ -22,7 +22,7 @@ from liansuo.remote.sim import LOST
 from liansuo.server.classroom import Classroom
 from liansuo.server.client import ClassroomClient
 from liansuo.server.websocket import ClassroomServer
-from liansuo.tui.layout import Ref
+from liansuo.tui.grid import Ref
 from liansuo.tui.paint import BAND_COLOUR, glyph
 
 PASSWORD = "correct horse"

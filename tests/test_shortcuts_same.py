@@ -158,16 +158,16 @@ class SkipChecked:
         if not self.real(lc, rs):
             return False
         self.skipped[rs.stage.value] += 1
-        memos = rs.release_memo, rs.standing_memo
+        memo = rs.memo
         before = self._state(lc, rs)
         lc.advance(rs)
-        assert self._state(lc, rs) == before, (rs.id, rs.stage, lc.il.now)
-        rs.release_memo, rs.standing_memo = memos
+        assert self._state(lc, rs) == before, (rs.id, rs.stage, lc.core.now)
+        rs.memo = memo
         return True
 
     @staticmethod
     def _state(lc: RouteLifecycle, rs: RouteState) -> Any:
-        il = lc.il
+        il = lc.core
         marks = (rs.stage, rs.entered, list(rs.released), list(rs.was_occupied), rs.overlap_release_at,
                  rs.release_at, rs.since, il.routes.get(rs.id) is rs)
         return (marks, dict(il.out.signals), il.locks.version, sorted(il.alarms), len(il.events),

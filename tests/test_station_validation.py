@@ -19,6 +19,7 @@ from pydantic import BaseModel
 
 from liansuo.kit.source import Diagnostic, StationError
 from liansuo.stations import schema
+from liansuo.stations import values as value_types
 from liansuo.stations.library import bundled
 from liansuo.stations.loader import load, load_text
 from liansuo.stations.rules import design_rules, min_coded_length
@@ -85,7 +86,7 @@ def test_minimal_example_loads() -> None:
 def test_kilometre_posts_are_metres() -> None:
     station = load_text(edit(BASE, ("{id: B-3, kind: buffer, at: 600}", "{id: B-3, kind: buffer, at: K0+600.0}")))
     assert station.ends["B-3"].at == 600.0
-    assert schema.parse_km("K12+345.6") == pytest.approx(12345.6)
+    assert value_types.parse_km("K12+345.6") == pytest.approx(12345.6)
 
 
 def test_integer_ids_are_taken_as_text() -> None:

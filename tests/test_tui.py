@@ -13,7 +13,7 @@ from consoletest import SIZE, message, run
 from liansuo.tui.app import ConsoleApp
 from liansuo.tui.diagram import Diagram
 from liansuo.tui.dialogs import ConfirmScreen, MenuScreen, PasswordScreen
-from liansuo.tui.layout import Ref
+from liansuo.tui.grid import Ref
 from liansuo.tui.paint import BAND_COLOUR, LAMP_COLOUR, glyph
 from liansuo.tui.panels import FunctionBar
 

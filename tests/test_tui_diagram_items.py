@@ -13,7 +13,8 @@ from liansuo.simulation.sim import Simulation
 from liansuo.tui.app import ConsoleApp
 from liansuo.tui.diagram import Diagram
 from liansuo.tui.dialogs import ConfirmScreen
-from liansuo.tui.layout import MIN_DOORS, Layout, Ref
+from liansuo.tui.grid import Layout, Ref
+from liansuo.tui.layout import MIN_DOORS
 from liansuo.tui.paint import LAMP_COLOUR, glyph, head_cell
 from liansuo.tui.panels import FunctionBar
 

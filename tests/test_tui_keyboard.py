@@ -16,7 +16,7 @@ from textual.widgets import Static
 from liansuo.tui.app import ConsoleApp
 from liansuo.tui.diagram import Diagram, nearest
 from liansuo.tui.dialogs import ConfirmScreen, HelpScreen, MenuScreen, place
-from liansuo.tui.layout import Ref
+from liansuo.tui.grid import Ref
 from liansuo.tui.paint import BAND_COLOUR
 
 

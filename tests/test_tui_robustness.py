@@ -21,7 +21,7 @@ from liansuo.stations.station import Station
 from liansuo.tui import longrun
 from liansuo.tui.app import ConsoleApp
 from liansuo.tui.dialogs import ConfirmScreen, HelpScreen, PasswordScreen, QuitScreen
-from liansuo.tui.layout import Ref
+from liansuo.tui.grid import Ref
 from liansuo.tui.operate import ConsoleOperator
 from liansuo.tui.safeapp import ConsoleScreen
 

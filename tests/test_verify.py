@@ -10,7 +10,7 @@ import pytest
 
 from liansuo.cli.main import main
 from liansuo.interlocking.lifecycle import RouteLifecycle
-from liansuo.interlocking.operations import Operator
+from liansuo.interlocking.selection import Selection
 from liansuo.proving.scripts import Script, ScriptTest, Step, run_test
 from liansuo.proving.verify import verify_station
 from liansuo.stations.library import bundled
@@ -97,7 +97,7 @@ def test_a_broken_interlocking_fails_with_a_script_that_replays_it(monkeypatch: 
 
 
 def test_a_conflict_the_interlocking_lets_through_is_caught(monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setattr(Operator, "route_blocker", lambda self, r, run_on=None: "")
+    monkeypatch.setattr(Selection, "route_blocker", lambda self, r, run_on=None: "")
     rep = verify_station("jiaopei", routes=["X-XI"])
     fail = next(f for f in rep.failures if f.check == "conflict")
     assert "conflicts with" in fail.detail and len([s for s in fail.steps if s.startswith(("route", "shunt"))]) == 2
@@ -134,7 +134,7 @@ def test_a_signal_opening_over_a_turnout_without_indication_is_caught_by_its_own
     from liansuo.proving.mutation.mutants import MUTANTS
 
     def setting(self: RouteLifecycle, rs: object) -> None:
-        il = self.il
+        il = self.core
         if il.now - rs.since > 1.0 and not any(t.id in il.moving or t.id in il.queue  # type: ignore[attr-defined]
                                                for t in rs.all_turnouts):  # type: ignore[attr-defined]
             rs.stage = RouteStage.locked  # type: ignore[attr-defined]

@@ -14,7 +14,7 @@ from hypothesis import strategies as hs
 
 from liansuo.cli.main import main
 from liansuo.interlocking.core import Core
-from liansuo.interlocking.operations import Operator
+from liansuo.interlocking.selection import Selection
 from liansuo.interlocking.table.build import InterlockingTable, build_table
 from liansuo.proving import verify as verify_module
 from liansuo.proving.mutation.cli import load_station
@@ -204,13 +204,13 @@ def test_a_coupling_through_no_shared_element_is_found_only_when_every_pair_is_s
                                                           None))
     i = next(k for k, m in enumerate(work.apart) if m)
     a, b = work.ids[i], work.ids[(work.apart[i] & -work.apart[i]).bit_length() - 1]
-    was = Operator.route_blocker
+    was = Selection.route_blocker
 
-    def route_blocker(self: Operator, r: Any, run_on: Any = None, **kw: Any) -> str:
+    def route_blocker(self: Selection, r: Any, run_on: Any = None, **kw: Any) -> str:
         coupled = {a: b, b: a}.get(r.id)
-        return "a seeded coupling" if coupled in self.il.routes else was(self, r, run_on, **kw)
+        return "a seeded coupling" if coupled in self.core.routes else was(self, r, run_on, **kw)
 
-    monkeypatch.setattr(Operator, "route_blocker", route_blocker)
+    monkeypatch.setattr(Selection, "route_blocker", route_blocker)
     assert verify_station("jiaopei").ok  # proven apart: the defect goes unseen, as the docs say
     full = verify_station("jiaopei", simulate_all=True)
     assert [f.subject for f in full.failures if f.check == "compatible"] == [f"{a} + {b}"]

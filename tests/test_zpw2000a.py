@@ -16,18 +16,16 @@ from liansuo.bench import report, zpw
 from liansuo.circuits.zpw.adjust import station_warnings
 from liansuo.circuits.zpw.model import (
     NO_FAULTS,
-    SweepResult,
     ZpwCircuit,
     ZpwFaults,
     ZpwState,
     capacitor_positions,
     layout_params,
     section_circuit,
-    single_faults,
     standard_positions,
-    sweep,
 )
 from liansuo.circuits.zpw.params import CARRIERS, DEFAULT_PARAMS, carrier_frequency_Hz
+from liansuo.circuits.zpw.sweep import SweepResult, single_faults, sweep
 from liansuo.cli.main import main
 from liansuo.kit.jsonreport import version
 from liansuo.stations.library import bundled

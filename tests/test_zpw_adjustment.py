@@ -22,7 +22,8 @@ from liansuo.circuits.zpw.adjust import (
     station_verdicts,
     table,
 )
-from liansuo.circuits.zpw.model import LAYOUTS, ZpwFaults, layout_params, standard_positions, sweep_section
+from liansuo.circuits.zpw.model import LAYOUTS, ZpwFaults, layout_params, standard_positions
+from liansuo.circuits.zpw.sweep import sweep_section
 from liansuo.cli.main import main
 from liansuo.stations.library import bundled
 from liansuo.stations.loader import load

@@ -7,7 +7,8 @@ import gc
 import time
 from typing import Any
 
-from liansuo.circuits.zpw.model import ZpwCircuit, standard_positions, sweep
+from liansuo.circuits.zpw.model import ZpwCircuit, standard_positions
+from liansuo.circuits.zpw.sweep import sweep
 
 ZPW_TARGET_CONFIGS_PER_S = 100_000.0
 ZPW_BALLASTS = (1.0, 1.5, 2.0, 3.0, 5.0, 10.0)  # ohm*km

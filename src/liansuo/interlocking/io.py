@@ -169,6 +169,9 @@ class Outputs:
             self.changed_turnouts.add(turnout)
 
 
+MAX_EVENTS = 20_000  # the events an interlocking keeps (and a console of the classroom shows): the last ones
+
+
 @dataclass(frozen=True)
 class Event:
     t: float
@@ -195,3 +198,15 @@ class Alarm:
     def key(self) -> str:
         """What names it (and what the console acknowledges it by)."""
         return self.key_of(self.kind, self.element, self.detail)
+
+
+@dataclass
+class Changes:
+    """What changed on the relay board since the last cycle."""
+
+    tracks: set[str]
+    turnouts: set[str]
+    signals: set[str]
+    doors: set[str]
+    pulses: dict[str, set[str]]
+    commanded: bool  # aspects set by operator commands since the last cycle

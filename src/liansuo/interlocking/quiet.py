@@ -23,7 +23,8 @@ from typing import TYPE_CHECKING
 from liansuo.interlocking.state import RouteStage, TurnoutState
 
 if TYPE_CHECKING:
-    from liansuo.interlocking.core import Changes, Core
+    from liansuo.interlocking.core import Core
+    from liansuo.interlocking.io import Changes
 
 
 @dataclass(frozen=True)

@@ -5,8 +5,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from enum import StrEnum
-from typing import Protocol
+from typing import ClassVar, Protocol
 
+from liansuo.interlocking.io import Changes
 from liansuo.interlocking.table.route import Route, RouteTurnout, RunOn
 
 
@@ -40,10 +41,8 @@ class RouteState:
     fault_release_at: dict[int, float] = field(default_factory=dict)
     guide_route: bool = False  # a guide route (引导进路锁闭): locked without its track circuits, opens only HB
     overlap_released: bool = False  # its overlap was released by section fault release before the signal was given
-    # in use: what the last release check saw, so that a cycle in which none of it changed skips it (lifecycle)
-    release_memo: ReleaseMemo | None = field(default=None, repr=False, compare=False)
-    # setting or open: what the last look at its turnouts, or at its open signal's conditions, read (lifecycle)
-    standing_memo: SettingMemo | OpenMemo | None = field(default=None, repr=False, compare=False)
+    # what the last cycle of its stage read (RouteMemo), so that a cycle in which none of it changed skips it
+    memo: RouteMemo | None = field(default=None, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         n = len(self.sections)
@@ -74,6 +73,17 @@ class RouteState:
         return self.turnouts + self.route.overlap_turnouts
 
 
+class RouteMemo(Protocol):
+    """What the handler of one stage of a route read when it last ran and changed nothing it would not change again
+    (:meth:`~.memos.Memos.unchanged`): ``holds`` when nothing of it changed in ``cycle``, the cycle after
+    ``cycle`` it was taken or last held through. Each kind knows the one ``stage`` it serves."""
+
+    stage: ClassVar[RouteStage]
+    cycle: int
+
+    def holds(self, rs: RouteState, cycle: int, changes: Changes) -> bool: ...
+
+
 class ReleaseMemo:
     """What the release check of a route in use (:meth:`~.lifecycle.RouteLifecycle._sequential_release`) left
     behind: its sections' release and occupation marks, the overlap timer and the run-on, and every section whose
@@ -82,6 +92,7 @@ class ReleaseMemo:
     only the relays that changed in the cycle after it are known."""
 
     __slots__ = ("cycle", "overlap_release_at", "released", "route", "run_on", "was_occupied", "watched")
+    stage: ClassVar[RouteStage] = RouteStage.in_use
 
     def __init__(self, rs: RouteState, cycle: int, watched: frozenset[str]) -> None:
         self.cycle = cycle
@@ -92,10 +103,9 @@ class ReleaseMemo:
         self.overlap_release_at = rs.overlap_release_at
         self.watched = watched
 
-    def holds(self, rs: RouteState, cycle: int, changed: set[str]) -> bool:
-        """Nothing the check reads changed since it last ran, with ``changed`` the track relays that changed in
-        ``cycle``."""
-        return (self.cycle == cycle - 1 and not rs.fault_release_at and self.watched.isdisjoint(changed)
+    def holds(self, rs: RouteState, cycle: int, changes: Changes) -> bool:
+        """Nothing the check reads changed since it last ran: its marks, and the track relays it watches."""
+        return (self.cycle == cycle - 1 and not rs.fault_release_at and self.watched.isdisjoint(changes.tracks)
                 and rs.released == self.released
                 and rs.was_occupied == self.was_occupied and rs.overlap_release_at == self.overlap_release_at
                 and rs.run_on is self.run_on and rs.route is self.route)
@@ -119,6 +129,7 @@ class SettingMemo:
     changed its indication since, they still are not."""
 
     __slots__ = ("cycle", "route", "run_on", "turnouts")
+    stage: ClassVar[RouteStage] = RouteStage.setting
 
     def __init__(self, rs: RouteState, cycle: int, reads: Reads) -> None:
         self.cycle = cycle
@@ -126,8 +137,8 @@ class SettingMemo:
         self.run_on = rs.run_on
         self.turnouts = reads.turnouts
 
-    def holds(self, rs: RouteState, cycle: int, turnouts_changed: set[str]) -> bool:
-        return (self.cycle == cycle - 1 and self.turnouts.isdisjoint(turnouts_changed) and rs.route is self.route
+    def holds(self, rs: RouteState, cycle: int, changes: Changes) -> bool:
+        return (self.cycle == cycle - 1 and self.turnouts.isdisjoint(changes.turnouts) and rs.route is self.route
                 and rs.run_on is self.run_on)
 
 
@@ -141,6 +152,7 @@ class OpenMemo:
 
     __slots__ = ("aspect", "cycle", "end_aspect", "ledger", "liaison", "onward", "onward_run_on", "reads", "route",
                  "run_on", "usu_failed")
+    stage: ClassVar[RouteStage] = RouteStage.open
 
     def __init__(self, rs: RouteState, cycle: int, reads: Reads, *, ledger: int, aspect: str | None,
                  end_aspect: str | None, onward: RouteState | None, liaison: tuple[object, ...],
@@ -157,24 +169,15 @@ class OpenMemo:
         self.liaison = liaison
         self.usu_failed = usu_failed
 
-    def holds(self, rs: RouteState, cycle: int, changes: _Changes) -> bool:
+    def holds(self, rs: RouteState, cycle: int, changes: Changes) -> bool:
         """None of the relays the supervision reads changed in ``cycle`` (the cycle after the memo's), the route and
         its run-on are the same, nothing entered it and nothing of it released. The interlocking's own state (locks,
-        aspects, the onward route, the line) is compared by :meth:`~.lifecycle.RouteLifecycle._open_unchanged`."""
+        aspects, the onward route, the line) is compared by :meth:`~.memos.Memos._open_unchanged`."""
         reads = self.reads
         return (self.cycle == cycle - 1 and rs.route is self.route and rs.run_on is self.run_on and not rs.entered
                 and not any(rs.released) and reads.sections.isdisjoint(changes.tracks)
                 and reads.turnouts.isdisjoint(changes.turnouts) and reads.signals.isdisjoint(changes.signals)
                 and reads.doors.isdisjoint(changes.doors))
-
-
-class _Changes(Protocol):
-    """The relays that changed in a cycle (``core.Changes``)."""
-
-    tracks: set[str]
-    turnouts: set[str]
-    signals: set[str]
-    doors: set[str]
 
 
 @dataclass

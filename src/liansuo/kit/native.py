@@ -35,17 +35,19 @@ from typing import Any
 # the compiled modules, as paths inside the package without ".py"
 MODULES = (
     "circuits/field", "circuits/lamps", "circuits/machines", "circuits/shunts", "circuits/trackcircuits",
-    "interlocking/cbi", "interlocking/core", "interlocking/io", "interlocking/lifecycle", "interlocking/locks",
-    "interlocking/operations", "interlocking/quiet", "interlocking/state",
+    "interlocking/cbi", "interlocking/core", "interlocking/equipment", "interlocking/io", "interlocking/lifecycle",
+    "interlocking/locks", "interlocking/memos", "interlocking/operations", "interlocking/quiet",
+    "interlocking/selection", "interlocking/state", "interlocking/throatguide",
     "simulation/commands", "simulation/neighbour", "simulation/view", "simulation/wiring",
     "simulation/trains/cabsignal", "simulation/trains/drivers", "simulation/trains/fleet",
     "simulation/trains/movement", "simulation/trains/odometerfeed", "simulation/trains/wheelsets",
     "proving/oracle/authority", "proving/oracle/ceiling", "proving/oracle/check", "proving/oracle/flank",
-    "proving/oracle/lamps", "proving/oracle/meet", "proving/oracle/watch",
+    "proving/oracle/lamps", "proving/oracle/meet", "proving/oracle/records", "proving/oracle/tables",
+    "proving/oracle/watch",
     "proving/verify/pairs", "proving/verify/probe",
 )
 # modules that replace what compiled modules define, and so run on the Python sources only (rule 2)
-PURE_ONLY = ("proving/mutation/mutants",)
+PURE_ONLY = ("proving/mutation/cbidefects", "proving/mutation/patching", "proving/mutation/tabledefects")
 # the layers that stay Python (rule 3)
 NEVER = ("stations/",)
 

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from liansuo.classroom.snapshot import SnapshotView
-from liansuo.interlocking.io import Event, Result
+from liansuo.interlocking.io import MAX_EVENTS, Event, Result
 from liansuo.interlocking.table.build import InterlockingTable, build_table
 from liansuo.remote.link import ServerLink, Unlinked
 from liansuo.rules import RuleSet, load_rules
@@ -28,7 +28,6 @@ from liansuo.stations.station import Station
 
 LOST = "connection to the classroom server lost, reconnecting"
 NOT_IN = "not logged in to the classroom yet"
-MAX_EVENTS = 20_000
 
 
 @dataclass(frozen=True)

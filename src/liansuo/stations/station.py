@@ -188,6 +188,16 @@ class Station:
         spans = [self.track_span(t) for t in self.section_tracks[section]]
         return max(hi for _, hi in spans) - min(lo for lo, _ in spans)
 
+    def far_end(self, track: str, node_from: str) -> Port:
+        """The port of ``track`` at its other end, walking along it from ``node_from``."""
+        a, b = self.track_ports[track]
+        return b if a.node == node_from else a
+
+    def across(self, joint: str, track: str) -> str:
+        """The track on the other side of ``joint`` from ``track``."""
+        lo, hi = self.joint_tracks(joint)
+        return hi if lo == track else lo
+
     def joint_tracks(self, joint: str) -> tuple[str, str]:
         """(track on the low side, track on the high side) of a joint."""
         found = self._joint_tracks.get(joint)

@@ -12,7 +12,6 @@ alarm panel and the console carries on (:mod:`tui.guard`, :mod:`tui.incidents`),
 from __future__ import annotations
 
 import os
-import random
 import time
 from pathlib import Path
 from typing import ClassVar
@@ -20,15 +19,14 @@ from typing import ClassVar
 from rich.text import Text
 from textual.actions import SkipAction
 from textual.app import ComposeResult
-from textual.binding import Binding, BindingType
+from textual.binding import BindingType
 from textual.containers import Horizontal, Vertical
 from textual.widgets import Footer, Input
 
-from liansuo.classroom.exercise import Exercise, GoalCheck, bundled_exercises, check_goal, parse_exercise
-from liansuo.classroom.passwords import ENV, hash_password, matches
+from liansuo.classroom.exercise import Exercise, GoalCheck
+from liansuo.classroom.passwords import ENV, hash_password
 from liansuo.classroom.roles import INSTRUCTOR, TRAINEE, command_word, refusal
 from liansuo.kit.printable import printable
-from liansuo.kit.source import StationError
 from liansuo.simulation import Result
 from liansuo.simulation.recording.recorder import FileRecorder
 from liansuo.simulation.sim import Simulation
@@ -36,12 +34,14 @@ from liansuo.tui.completion import example_route
 from liansuo.tui.consolesim import ConsoleSim
 from liansuo.tui.describe import describe
 from liansuo.tui.diagram import Diagram
-from liansuo.tui.dialogs import ConfirmScreen, HelpScreen, MenuScreen, PasswordScreen
+from liansuo.tui.dialogs import ConfirmScreen, HelpScreen, MenuScreen
+from liansuo.tui.grid import Ref
 from liansuo.tui.incidents import KEY_PREFIX, Incident
 from liansuo.tui.instructor import InstructorPanel
-from liansuo.tui.layout import Ref
+from liansuo.tui.keys import CONSOLE_BINDINGS
+from liansuo.tui.lesson import LessonControls
 from liansuo.tui.longrun import LongRun, requested_run
-from liansuo.tui.operate import MODES, ConsoleOperator, PressOutcome
+from liansuo.tui.operate import ConsoleOperator, PressOutcome
 from liansuo.tui.panels import (
     AlarmBell,
     AlarmLine,
@@ -54,6 +54,7 @@ from liansuo.tui.panels import (
     StatusBar,
     clock_text,
     read_alarms,
+    sender,
     waiting_text,
 )
 from liansuo.tui.safeapp import SafeApp
@@ -61,17 +62,11 @@ from liansuo.tui.safeapp import SafeApp
 SPEEDS = (0.25, 0.5, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0, 64.0)
 TICK_S = 0.125  # redraw at 8 Hz: often enough for the USU flash (35 per minute)
 MAX_STEPS_PER_TICK = 400
-PASSWORD_ENV = ENV  # the instructor password, in the environment
 QUIT_WORDS = ("quit", "exit")  # typed in the command bar, they close the console (after asking), as ctrl+q does
 MUTE_WORDS = {"mute": True, "unmute": False}  # typed in the command bar, they mute or unmute the alarm bell, as m does
 
 
-def who(source: str) -> str:
-    """How the event log names who sent a command."""
-    return {"trainee": "trainee>", "instructor": "instr.>", "exercise": "lesson>"}.get(source, f"{source}>")
-
-
-class ConsoleApp(SafeApp):
+class ConsoleApp(SafeApp, LessonControls):
     TITLE = "liansuo 联锁"
     # The console runs its simulation's clock (pause, speed, a typed 'run' in slices); a classroom's client does not:
     # the server runs it (remote/app.py)
@@ -95,19 +90,7 @@ class ConsoleApp(SafeApp):
     EventLog { width: 3fr; }
     """
 
-    BINDINGS: ClassVar[list[BindingType]] = [
-        Binding("colon", "command_bar", "command", key_display=":", priority=True),
-        Binding("space", "pause", "pause/run", key_display="space"),
-        Binding("full_stop", "step", "step", show=False),
-        Binding("greater_than_sign", "speed(1)", "faster", show=False),
-        Binding("less_than_sign", "speed(-1)", "slower", show=False),
-        Binding("escape", "escape", "drop", show=False),
-        Binding("a", "acknowledge", "ack alarms", show=False),
-        Binding("m", "mute", "mute bell", show=False),
-        Binding("f1,question_mark", "help", "help", key_display="?"),
-        Binding("f2", "instructor", "instructor", key_display="F2"),
-        *[Binding(m.key, f"arm('{m.name}')", m.en, show=False) for m in MODES.values()],
-    ]
+    BINDINGS: ClassVar[list[BindingType]] = CONSOLE_BINDINGS
 
     def __init__(self, station: str = "jiaopei", *, paused: bool = False, speed: float = 1.0,
                  instructor_password: str | None = None, instructor_hash: str | None = None,
@@ -119,9 +102,8 @@ class ConsoleApp(SafeApp):
         self.operator = ConsoleOperator(self.sim)
         self.paused = paused
         self.speed = speed
-        # the instructor's password, kept hashed: given as a hash (a password file), as a password, or in the
-        # environment; None opens instructor mode without one
-        plain = instructor_password if instructor_password is not None else os.environ.get(PASSWORD_ENV)
+        # the instructor's password, hashed: from a password file, the argument or the environment; None: none asked
+        plain = instructor_password if instructor_password is not None else os.environ.get(ENV)
         self.password = instructor_hash or (hash_password(plain) if plain else None)
         self.instructor = False
         self.acknowledged: set[str] = set()
@@ -157,12 +139,6 @@ class ConsoleApp(SafeApp):
         yield MessageLine(id="message")
         yield CommandBar(lambda: self.sim, id="command")
         yield Footer()
-
-    def _exercise_files(self) -> list[Path]:
-        files = bundled_exercises()
-        if self._exercise_arg is not None and Path(self._exercise_arg) not in files:
-            files.append(Path(self._exercise_arg))
-        return files
 
     def on_mount(self) -> None:
         # the main screen's widgets, kept so the clock and the answers reach them while a dialog is open
@@ -322,14 +298,7 @@ class ConsoleApp(SafeApp):
         counting = self.diagram.frame().countdown if self.diagram.layout_ is not None else {}
         if counting:
             out.append("│ 人解 " + " ".join(f"{s} {n}s" for s, n in sorted(counting.items())) + " ", style="#ffd700")
-        out.append("│ 教员 INSTRUCTOR " if self.instructor else "│ trainee ", style="#d0a0ff" if self.instructor
-                   else "")
-        if self.exercise is not None:
-            done = self.goal_reached_at is not None
-            out.append(printable(f"│ {self.exercise.title}: {'goal reached' if done else 'in progress'} "),
-                       style="bold #40e070" if done else "#ffd700")
-        if self.recorder is not None:
-            out.append("│ ● REC ", style="#ff5050")
+        self.lesson_status(out)
         return out
 
     # ---- commands ----
@@ -357,7 +326,7 @@ class ConsoleApp(SafeApp):
             seconds = requested_run(self.sim, line) if self.LOCAL_CLOCK and source in ("trainee", "instructor") \
                 else None
             if seconds is not None:
-                self.log_panel.add(f"{self.sim.t:9.2f} {who(source):8} {line}", "#9fd3ff")
+                self.log_panel.add(f"{self.sim.t:9.2f} {sender(source):8} {line}", "#9fd3ff")
                 result = self.start_run(line, source, seconds)
                 self.refresh_views()
                 return result
@@ -370,7 +339,7 @@ class ConsoleApp(SafeApp):
             self.refresh_views()
             return result
         log = self.log_panel
-        log.add(f"{self.sim.t:9.2f} {who(source):8} {line}", "#9fd3ff" if source == "trainee" else "#d0a0ff")
+        log.add(f"{self.sim.t:9.2f} {sender(source):8} {line}", "#9fd3ff" if source == "trainee" else "#d0a0ff")
         if not result.ok:
             log.add(f"{self.sim.t:9.2f} {'refused':8} {result.message}", "#ff8080")
         if result.message or not result.ok:
@@ -529,87 +498,3 @@ class ConsoleApp(SafeApp):
     def action_help(self) -> None:
         self.push_screen(HelpScreen(example_route(self.sim)))
 
-    async def action_instructor(self) -> None:
-        if self.instructor:
-            await self.set_instructor(False)
-        elif self.password:
-            self.push_screen(PasswordScreen(), self._password_given)
-        else:
-            await self.set_instructor(True)
-
-    async def _password_given(self, given: str | None) -> None:
-        if given and self.password and matches(given, self.password):
-            await self.set_instructor(True)
-        elif given:
-            self.say("wrong instructor password", False)
-        else:
-            self.say("instructor mode not opened")
-
-    async def set_instructor(self, on: bool) -> None:
-        if on and self.instructor_panel is None:
-            main = self.screen_stack[0].query_one("#main")
-            if not main.is_attached:
-                return  # the console is closing (quit answered yes, F2 typed before it closed): nothing to open
-            self.instructor_panel = InstructorPanel(lambda: self.sim, self._exercise_files(), id="instructor")
-            await main.mount(self.instructor_panel)
-            if self.recorder is not None:
-                self.instructor_panel.show_recording(f"recording to {self.recorder.path}")
-            self._show_goal()
-        self.instructor = on
-        if self.instructor_panel is not None:
-            self.instructor_panel.set_class(on, "-shown")
-        self.say("instructor mode: faults, trains and exercises in the panel on the right (F2 closes it)" if on
-                 else "trainee mode")
-        self.refresh_views()
-
-    # ---- instructor panel ----
-    def on_instructor_panel_send(self, event: InstructorPanel.Send) -> None:
-        self.send(event.line, "instructor")
-
-    def on_instructor_panel_load_exercise(self, event: InstructorPanel.LoadExercise) -> None:
-        self.load_exercise(event.path)
-
-    def load_exercise(self, path: str) -> None:
-        self.stop_run()
-        if not isinstance(self.sim, Simulation):
-            self.say("an exercise runs on the simulation's own computer: start it from there", False)
-            return
-        try:
-            ex = parse_exercise(path)
-        except StationError as exc:
-            self.say(f"exercise not loaded: {exc.diagnostics[0] if exc.diagnostics else exc}", False)
-            return
-        except OSError as exc:
-            self.say(f"exercise not loaded: {exc}", False)
-            return
-        if ex.station_ref() not in (self.station_ref, self.sim.station.id):
-            self.say(f"exercise '{ex.title}' is for station {ex.station}; start the console with "
-                     f"'liansuo tui {ex.station} --exercise {path}'", False)
-            return
-        self.exercise = ex
-        self.goal_reached_at = None
-        self.goals_met = set()
-        seed = random.randrange(1_000_000)  # the pool's draw; the log names it so a lesson can be given again
-        self.log_panel.add(f"{self.sim.t:9.2f} {'lesson':8} {ex.title}: {ex.briefing} (seed {seed})", "#d0a0ff")
-        for line in ex.lines(seed):
-            self.send(line, "exercise")
-        self.say(f"exercise: {ex.title}. Goal: {ex.goal}")
-        self.check_exercise()
-
-    def check_exercise(self) -> None:
-        ex = self.exercise
-        if ex is None or not isinstance(self.sim, Simulation):
-            return
-        self.goal = check_goal(self.sim, ex, self.goals_met)
-        if self.goal.reached and self.goal_reached_at is None:
-            self.goal_reached_at = self.sim.t
-            self.log_panel.add(f"{self.sim.t:9.2f} {'lesson':8} goal reached: {ex.goal}", "bold #40e070")
-            self.say(f"goal reached: {ex.goal}", True)
-        self._show_goal()
-
-    def _show_goal(self) -> None:
-        ex, goal = self.exercise, self.goal
-        if ex is None or goal is None or self.instructor_panel is None:
-            return
-        lines = "\n".join(f"{'✓' if ok else '·'} {line.removeprefix('expect ')}" for line, ok, _ in goal.lines)
-        self.instructor_panel.show_goal(f"{ex.title}\n{ex.goal}\n{lines}")

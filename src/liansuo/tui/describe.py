@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from liansuo.tui.layout import Ref
+from liansuo.tui.grid import Ref
 
 if TYPE_CHECKING:
     from liansuo.tui.consolesim import ConsoleSim

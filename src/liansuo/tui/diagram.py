@@ -20,8 +20,9 @@ from textual.message import Message
 from textual.scroll_view import ScrollView
 from textual.strip import Strip
 
+from liansuo.tui.grid import Layout, Ref
 from liansuo.tui.guard import Guarded
-from liansuo.tui.layout import MAX_ZOOM, Layout, Ref, build_layout
+from liansuo.tui.layout import MAX_ZOOM, build_layout
 from liansuo.tui.paint import S_CURSOR, Frame, add_overlays, glyph, read_frame
 
 if TYPE_CHECKING:

@@ -18,8 +18,8 @@ from textual.widgets import Button, Input, Label, Select, Static
 
 from liansuo.circuits.faults import KINDS
 from liansuo.tui.completion import fault_targets
+from liansuo.tui.grid import Ref
 from liansuo.tui.guard import Guarded
-from liansuo.tui.layout import Ref
 from liansuo.tui.plain import plain
 
 if TYPE_CHECKING:

@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING
 from rich.style import Style
 
 from liansuo.kit.printable import printable
-from liansuo.tui.layout import Glyph, Layout, Ref
+from liansuo.tui.grid import Glyph, Layout, Ref
 
 if TYPE_CHECKING:
     from liansuo.tui.consolesim import ConsoleSim

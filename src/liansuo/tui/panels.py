@@ -21,8 +21,8 @@ from textual.widgets import Input, RichLog, Static
 from liansuo.classroom.snapshot import EventCursor
 from liansuo.kit.printable import printable
 from liansuo.tui.completion import candidates, complete, example_route
+from liansuo.tui.grid import Ref
 from liansuo.tui.guard import Guarded
-from liansuo.tui.layout import Ref
 from liansuo.tui.operate import MODES
 
 if TYPE_CHECKING:
@@ -47,6 +47,11 @@ def clock_text(t: float) -> str:
     h, rest = divmod(t, 3600)
     m, s = divmod(rest, 60)
     return f"{int(h):02d}:{int(m):02d}:{s:04.1f}"
+
+
+def sender(source: str) -> str:
+    """How the event log names who sent a command."""
+    return {"trainee": "trainee>", "instructor": "instr.>", "exercise": "lesson>"}.get(source, f"{source}>")
 
 
 class StatusBar(Guarded, Static):

@@ -21,7 +21,7 @@ from liansuo.simulation.recording.replayer import Replayer
 from liansuo.simulation.timeparse import parse_duration
 from liansuo.stations.station import Station
 from liansuo.tui.app import ConsoleApp
-from liansuo.tui.layout import Ref
+from liansuo.tui.grid import Ref
 from liansuo.tui.panels import clock_text
 
 

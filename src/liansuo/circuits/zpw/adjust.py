@@ -36,13 +36,12 @@ from liansuo.circuits.zpw.model import (
     ZpwCircuit,
     ZpwFaults,
     capacitor_positions,
-    fault_label,
     layout_params,
     section_layout,
     standard_positions,
-    sweep_section,
 )
 from liansuo.circuits.zpw.params import BASE_CARRIERS, DEFAULT_PARAMS, ZpwParams
+from liansuo.circuits.zpw.sweep import fault_label, sweep_section
 from liansuo.kit.safeyaml import build, compose, read_file
 
 if TYPE_CHECKING:

@@ -63,7 +63,8 @@ def collect_faults(station: Station, specs: Sequence[str]) -> dict[str, dict[int
 def section_rows(station: Station, faults: dict[str, dict[int, str]] | None = None) -> list[dict[str, Any]]:
     """One row per ZPW-2000A section, in file order, with the fault applied where one is given."""
     from liansuo.circuits.zpw.adjust import section_circuit
-    from liansuo.circuits.zpw.model import ZpwFaults, fault_label
+    from liansuo.circuits.zpw.model import ZpwFaults
+    from liansuo.circuits.zpw.sweep import fault_label
 
     rows = []
     for sid in zpw_sections(station):

@@ -29,7 +29,7 @@ from __future__ import annotations
 import cmath
 import dataclasses
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Literal
 
@@ -40,7 +40,6 @@ from liansuo.circuits.physical import check_ballast, check_position, check_shunt
 from liansuo.circuits.zpw import ends as zpwends
 from liansuo.circuits.zpw.ends import Ends
 from liansuo.circuits.zpw.params import (
-    CARRIERS,
     DEFAULT_PARAMS,
     ZpwParams,
     base_index,
@@ -187,101 +186,9 @@ def solve(length_m: float, capacitors_s: Sequence[float], ycap: CArray, shunts_s
     return v0, np.moveaxis(vrx, 0, -1), np.moveaxis(vrx * i_tx_side, 0, -1), vtx0
 
 
-def _capacitor_table(carriers: Sequence[str], faults: Sequence[Mapping[int, str]], n: int, params: ZpwParams,
-                     capacitance_uF: float | None = None) -> CArray:
-    """(C, F, N) admittances: each fault case maps 1-based capacitor numbers to open / half / short."""
-    ok = np.array([params.capacitor_admittance(c, "ok", capacitance_uF) for c in carriers])
-    factor = np.ones((len(faults), n))
-    short = np.zeros((len(faults), n), dtype=bool)
-    for f, case in enumerate(faults):
-        for number, mode in case.items():
-            if not 1 <= number <= n:
-                raise ValueError(f"capacitor {number} does not exist: the section has {n}")
-            if mode not in FAULT_MODES:
-                raise ValueError(f"unknown capacitor fault '{mode}': use open, half or short")
-            factor[f, number - 1] = {"open": 0.0, "half": 0.5, "short": 1.0}[mode]
-            short[f, number - 1] = mode == "short"
-    table = ok[:, None, None] * factor[None]
-    table[:, short] = 1.0 / params.capacitor_short_ohm
-    return table
-
-
-def single_faults(n: int, modes: Sequence[str] = FAULT_MODES) -> list[dict[int, str]]:
-    """No fault, then every capacitor in every mode, one at a time (Luo Ying's fault cases, docs/references.md)."""
-    return [{}] + [{k: m} for m in modes for k in range(1, n + 1)]
-
-
-def fault_label(case: Mapping[int, str]) -> str:
-    return ", ".join(f"C{k} {m}" for k, m in sorted(case.items())) or "none"
-
-
 def profile_points(length_m: float, step_m: float) -> FArray:
     """Shunt positions every ``step_m`` (at most), both ends included."""
     return np.linspace(0.0, length_m, max(2, math.ceil(length_m / step_m - 1e-9) + 1))
-
-
-@dataclass(frozen=True)
-class SweepResult:
-    """One section length: every carrier x ballast x fault case (x shunt position). Positions from the lower end."""
-
-    length_m: float
-    capacitors_m: tuple[float, ...]
-    carriers: tuple[str, ...]
-    ballasts_ohm_km: tuple[float, ...]
-    faults: tuple[Mapping[int, str], ...]
-    positions_m: FArray
-    adjustment_mV: FArray  # (C, B, F)
-    residual_mV: FArray  # (C, B, F, P)
-    cab_current_mA: FArray  # (C, B, F, P)
-    small_track_mV: FArray  # (C, B, F): the small track (transmitter-end tuning area) as its receiver reads it
-
-    @property
-    def max_shunt_residual_mV(self) -> FArray:
-        return np.asarray(self.residual_mV.max(axis=-1))
-
-    @property
-    def min_cab_current_mA(self) -> FArray:
-        return np.asarray(self.cab_current_mA.min(axis=-1))
-
-    @property
-    def configurations(self) -> int:
-        """Shunted configurations (carrier, ballast, fault case, shunt position) evaluated."""
-        return int(self.residual_mV.size)
-
-
-def sweep_section(length_m: float, capacitors_m: Sequence[float], carriers: Sequence[str] = CARRIERS,
-                  ballasts: Sequence[float] = (1.0,), faults: Sequence[Mapping[int, str]] | None = None,
-                  positions_m: Sequence[float] | None = None, params: ZpwParams = DEFAULT_PARAMS,
-                  capacitance_uF: float | None = None) -> SweepResult:
-    """Every configuration of one section at once; receiver gain set per carrier as ``ZpwCircuit`` sets it."""
-    for b in ballasts:
-        check_ballast("ballasts", b)
-    caps = sorted(capacitors_m)
-    cases = single_faults(len(caps)) if faults is None else list(faults)
-    pos = profile_points(length_m, params.profile_step_m) if positions_m is None else np.asarray(positions_m, float)
-    z = np.array([params.rail_impedance(c) for c in carriers])
-    ycap = _capacitor_table(carriers, cases, len(caps), params, capacitance_uF)
-    healthy = _capacitor_table(carriers, [{}], len(caps), params, capacitance_uF)
-    design = [[zpwends.section_ends(params, c)] for c in carriers]
-    reference, _, _, vtx_ref = solve(length_m, caps, healthy, (), z, (params.ballast_ohm_km,), params, ends=design)
-    gain = params.adjust_mV / np.abs(reference[:, 0, 0])  # mV per rail volt, per carrier
-    small = np.array([e[0].small_track for e in design])
-    reach = np.abs(vtx_ref[:, 0, 0] * small)  # 0 with insulated joints: no small track
-    small_gain = np.divide(params.adjust_mV, reach, out=np.zeros_like(reach), where=reach > 0)  # adjusted alike
-    ends = [[zpwends.section_ends(params, c, b) for b in ballasts] for c in carriers]
-    v0, v, i, vtx = solve(length_m, caps, ycap, pos, z, ballasts, params, ends=ends)
-    small_b = np.array([[e.small_track for e in row] for row in ends])[..., None]
-    return SweepResult(float(length_m), tuple(caps), tuple(carriers), tuple(float(b) for b in ballasts),
-                       tuple(cases), pos, np.abs(v0) * gain[:, None, None], np.abs(v) * gain[:, None, None, None],
-                       np.abs(i) * 1000.0, np.abs(vtx * small_b) * small_gain[:, None, None])
-
-
-def sweep(lengths: Sequence[float], carriers: Sequence[str] = CARRIERS, ballasts: Sequence[float] = (1.0,),
-          faults: Sequence[Mapping[int, str]] | None = None, params: ZpwParams = DEFAULT_PARAMS,
-          ) -> list[SweepResult]:
-    """Sections of each length with standard capacitors; ``faults`` None = every single capacitor fault."""
-    return [sweep_section(length, standard_positions(length, None, params), carriers, ballasts, faults,
-                          params=params) for length in lengths]
 
 
 # ---- one section in the live simulation ----------------------------------------------------------------------------

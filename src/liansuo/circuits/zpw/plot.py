@@ -98,7 +98,8 @@ def _worst(circuit: Any, cases: list[dict[int, str]]) -> list[dict[int, str]]:
 def profiles(station: Station, section: str, cases: Sequence[dict[int, str]]) -> list[Profile]:
     """The healthy profile, then one per fault case."""
     from liansuo.circuits.zpw.adjust import section_circuit
-    from liansuo.circuits.zpw.model import ZpwFaults, fault_label
+    from liansuo.circuits.zpw.model import ZpwFaults
+    from liansuo.circuits.zpw.sweep import fault_label
 
     circuit = section_circuit(station, section)
     out = []

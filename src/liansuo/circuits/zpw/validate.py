@@ -106,7 +106,8 @@ def _changes(section: ArticleSection, carriers: Sequence[str], ballast: float) -
     own design minimum, with its layout's capacitors (which differ by carrier)."""
     import numpy as np
 
-    from liansuo.circuits.zpw.model import layout_params, standard_positions, sweep_section
+    from liansuo.circuits.zpw.model import layout_params, standard_positions
+    from liansuo.circuits.zpw.sweep import sweep_section
 
     modes = ("open", "half")
     per_carrier: list[dict[str, Any]] = []

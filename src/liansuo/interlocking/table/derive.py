@@ -1,13 +1,7 @@
 """Deriving the interlocking table from the topology: the routes between buttons, and for each its turnouts (route,
 flank protection, driven), sections, fouling sections, approach sections, overlap, diamonds, and where a shunting
-route runs on past its end. The enemy routes are :mod:`.conflicts`' work.
-
-Flank protection (防护道岔): the first turnout met from the free leg of a route turnout (directly, or across joints
-within the throat, short of a signal that stops movements heading for the route), met on its normal or reverse leg,
-must lie the other way, unless that way also leads into the route
-(onto a track of the route or one crossing it at a diamond, as the other diagonal of a scissors crossover does).
-A diamond the route runs over is protected the same way: the turnouts whose legs lead onto the crossing track must
-lie away from it, so a route over one diagonal of a scissors crossover keeps the other pair normal.
+route runs on past its end. Flank protection, driven turnouts and fouling sections are :mod:`.flank`'s work, the
+run-on :mod:`.runon`'s, the approach sections :mod:`.approach`'s, the enemy routes :mod:`.conflicts`'.
 """
 
 from __future__ import annotations
@@ -20,20 +14,17 @@ from itertools import pairwise
 import networkx as nx
 
 from liansuo.interlocking.aspects import possible_aspects
+from liansuo.interlocking.table import approach
 from liansuo.interlocking.table.conflicts import derive_conflicts
+from liansuo.interlocking.table.flank import Flank, driven_turnouts
 from liansuo.interlocking.table.overlap import profile_overlap
 from liansuo.interlocking.table.route import KINDS, FoulingSection, InterlockingTable, Kind, Route, RouteTurnout, RunOn
+from liansuo.interlocking.table.runon import RunOns
 from liansuo.kit.source import Diagnostic, StationError
 from liansuo.rules import RuleSet
-from liansuo.stations.schema import Button, Direction, Link, SectionRole, SignalKind, TurnoutPosition
+from liansuo.stations.schema import Button, Direction, SectionRole, SignalKind, TurnoutPosition
 from liansuo.stations.station import Station
 from liansuo.stations.topology import Move, Path
-
-_AT_SIGHT = (SectionRole.station_track, SectionRole.spur)
-
-
-def _other(pos: TurnoutPosition | str) -> TurnoutPosition:
-    return TurnoutPosition.reverse if str(pos) == "normal" else TurnoutPosition.normal
 
 
 @dataclass(frozen=True)
@@ -50,6 +41,8 @@ class _Builder:
         self.st = station
         self.rules = rules
         self.topo = station.topology
+        self.flank = Flank(station, rules)
+        self.run_ons = RunOns(station, self.flank)
         self.errors: list[Diagnostic] = []
         self.warnings: list[Diagnostic] = []  # design warnings: routes left out of the table, and why
         self._warned: set[tuple[str, str, Direction]] = set()
@@ -160,220 +153,6 @@ class _Builder:
         length = sum(self.st.track_length(t) for t, _ in moves)
         return self.topo._path(start, d, moves, turnouts, joints, length, self.topo.far_node(moves[-1]))
 
-    # ---- flank protection and fouling -----------------------------------------------------------------------
-    def _flank(self, tracks: Sequence[str], turnouts: Sequence[tuple[str, TurnoutPosition]],
-               skip: set[str]) -> tuple[dict[str, TurnoutPosition], list[FoulingSection]]:
-        """Protection turnouts (turnout -> position) and fouling sections of a path over ``tracks`` with
-        ``turnouts``; turnouts in ``skip`` (already in the route) are never asked to protect it."""
-        st = self.st
-        on_path = set(tracks)
-        crossing = {o for t in tracks for _, o in st.crossings.get(t, ())} - on_path
-        protection: dict[str, TurnoutPosition] = {}
-        fouling: list[FoulingSection] = []
-
-        def protect(u: str, leg: str) -> None:
-            if leg == "point" or u in skip or u in protection:
-                return
-            away = _other(leg)
-            if not self._leads_onto(st.leg_track(u, away.value), u, on_path | crossing):
-                protection[u] = away
-
-        for t, pos in turnouts:
-            fouling += self._fouling_tied(t, pos)
-            track, node_from = st.leg_track(t, _other(pos).value), t
-            joints = 0
-            while track not in on_path:
-                a, b = st.track_ports[track]
-                far = b if a.node == node_from else a
-                if joints == 1 and any(fp.track == track for fp in st.model.fouling_points):
-                    # a fouling point on the first track past the joint: the joint lies inside the fouling limit
-                    fouling.append(FoulingSection(st.tracks[track].section, t, pos))
-                if st.sections[st.tracks[track].section].role is not SectionRole.throat:
-                    break
-                if far.leg is not None:
-                    protect(far.node, far.leg)
-                    break
-                if far.node not in st.joints or self._guards(far.node, node_from):
-                    break
-                lo, hi = st.joint_tracks(far.node)
-                track, node_from = (hi if lo == track else lo), far.node
-                joints += 1
-        for x in sorted(crossing):  # a vehicle standing on a track that crosses the path fouls the crossing
-            diamond = next(d for t in tracks for d, o in st.crossings.get(t, ()) if o == x)
-            fouling.append(FoulingSection(st.tracks[x].section, diamond=diamond))
-            for port in st.track_ports[x]:
-                if port.leg is not None:
-                    protect(port.node, port.leg)
-                elif port.node in st.joints:
-                    lo, hi = st.joint_tracks(port.node)
-                    nxt = hi if lo == x else lo
-                    a, b = st.track_ports[nxt]
-                    far = b if a.node == port.node else a
-                    if far.leg is not None:
-                        protect(far.node, far.leg)
-        return protection, list(dict.fromkeys(fouling))
-
-    def _fouling_tied(self, turnout: str, pos: TurnoutPosition) -> list[FoulingSection]:
-        """Fouling sections from the fouling points tied to ``turnout`` (``turnout`` + ``tracks`` in the file), for a
-        route over it in ``pos``: where the first joint on the other leg lies nearer the turnout than the fouling
-        point plus the clearance (侵限绝缘), a vehicle standing just beyond that joint fouls the route."""
-        st = self.st
-        design = self.rules.design
-        clearance = design.fouling_clearance_emu_m if st.model.emu else design.fouling_clearance_m
-        at = st.turnouts[turnout].at
-        out: list[FoulingSection] = []
-        for fp in st.model.fouling_points:
-            if fp.turnout != turnout:
-                continue
-            chain = st.fouling_legs(fp).get(_other(pos).value, [])
-            joint = chain[0][1] if chain else None
-            if joint is None or joint not in st.joints:
-                continue
-            if abs(st.joints[joint].at - at) < abs(fp.at - at) + clearance:
-                lo, hi = st.joint_tracks(joint)
-                beyond = hi if lo == chain[0][0] else lo
-                out.append(FoulingSection(st.tracks[beyond].section, turnout, pos))
-        return out
-
-    def _guards(self, joint: str, behind: str) -> bool:
-        """Does a signal at ``joint`` face movements heading from it towards ``behind`` (so it stops them)?"""
-        st = self.st
-        towards = Direction.up if st.node_at(joint) > st.node_at(behind) else Direction.down
-        return any(s.direction is towards for s in st.signals_at(joint))
-
-    def _leads_onto(self, track: str, node_from: str, tracks: set[str]) -> bool:
-        """Does a movement leaving ``node_from`` along ``track`` reach one of ``tracks`` before another turnout
-        (across at most one joint)?"""
-        st = self.st
-        for _ in range(2):
-            if track in tracks:
-                return True
-            a, b = st.track_ports[track]
-            far = b if a.node == node_from else a
-            if far.leg is not None or far.node not in st.joints:
-                return False
-            lo, hi = st.joint_tracks(far.node)
-            track, node_from = (hi if lo == track else lo), far.node
-        return track in tracks
-
-    # ---- beyond the end of a shunting route ------------------------------------------------------------------------
-    def _run_on(self, end_node: str, d: Direction, route_tracks: Sequence[str],
-                route_turnouts: set[str]) -> tuple[str | None, tuple[RunOn, ...]]:
-        """(track led into at sight, run-ons) of a shunting route ending at a signal of the other direction at
-        ``end_node``: the movement goes on to the next signal of its own direction, the station limit, an end, or
-        into a station track or spur at sight, whichever way the turnouts beyond lie."""
-        st = self.st
-        if end_node not in st.joints or any(s.direction is d for s in st.signals_at(end_node)):
-            return None, ()  # the end of the network, or a signal of its own direction stops it there
-        first = st.entry_track(end_node, d)
-        if st.sections[st.tracks[first].section].role in _AT_SIGHT:
-            return st.tracks[first].section, ()
-        out: list[RunOn] = []
-        stack: list[tuple[str, list[str], list[tuple[str, TurnoutPosition]], list[tuple[str, TurnoutPosition]]]] = [
-            (first, [], [], [])]
-        while stack:
-            track, tracks, when, turnouts = stack.pop()
-            tracks = [*tracks, track]
-            far = self.topo.far_node((track, d))
-            if far in st.joints:
-                signals = st.signals_at(far)
-                nxt = st.entry_track(far, d)
-                stop_here = any(s.direction is d for s in signals) or any(
-                    s.direction is not d and s.kind is SignalKind.home for s in signals)
-                into = st.tracks[nxt].section if st.sections[st.tracks[nxt].section].role in _AT_SIGHT else None
-                if not stop_here and into is None:
-                    stack.append((nxt, tracks, when, turnouts))
-                    continue
-                out.append(self._one_run_on(tracks, when, turnouts, into, far, route_tracks, route_turnouts))
-                continue
-            if far in st.ends or len(tracks) > 200:
-                out.append(self._one_run_on(tracks, when, turnouts, None, far, route_tracks, route_turnouts))
-                continue
-            leg = next(p.leg for p in st.track_ports[track] if p.node == far)
-            if leg == "point":
-                for pos in (TurnoutPosition.normal, TurnoutPosition.reverse):
-                    stack.append((st.leg_track(far, pos.value), tracks, [*when, (far, pos)],
-                                  [*turnouts, (far, pos)]))
-            else:
-                pos = TurnoutPosition(str(leg))
-                stack.append((st.leg_track(far, "point"), tracks, when, [*turnouts, (far, pos)]))
-        return None, tuple(sorted(out, key=lambda ro: ro.when))
-
-    def _one_run_on(self, tracks: list[str], when: list[tuple[str, TurnoutPosition]],
-                    turnouts: list[tuple[str, TurnoutPosition]], into: str | None, end: str,
-                    route_tracks: Sequence[str], route_turnouts: set[str]) -> RunOn:
-        sections = list(dict.fromkeys(self.st.tracks[t].section for t in tracks))
-        needed = [RouteTurnout(t, p, "route") for t, p in turnouts]
-        pairs = self._partners([t for t, _ in turnouts], dict(turnouts), route_turnouts)
-        skip = route_turnouts | {t for t, _ in turnouts} | set(pairs)
-        prot, _ = self._flank([*route_tracks, *tracks], turnouts, skip)
-        needed += [RouteTurnout(t, p, "driven") for t, p in pairs.items()]
-        needed += [RouteTurnout(t, p, "protection") for t, p in prot.items()]
-        return RunOn(tuple(when), tuple(sections), tuple(needed), into, end)
-
-    def _partners(self, turnouts: Sequence[str], positions: dict[str, TurnoutPosition],
-                  skip: set[str]) -> dict[str, TurnoutPosition]:
-        """The driven turnouts (带动道岔) of ``turnouts``: the crossover partners that move with them and lie as they
-        do, and the turnouts the station file has a turnout drive when a route sets it (``drives``). A turnout the
-        route itself runs over keeps the route's position."""
-        out: dict[str, TurnoutPosition] = {}
-        for t in turnouts:
-            pair = self.st.turnouts[t].pair
-            for partner in self.st.pairs[pair] if pair else []:
-                if partner not in positions and partner not in skip:
-                    out.setdefault(partner, positions[t])
-            for d in self.st.turnouts[t].drives:
-                if d.when == positions[t].value and d.turnout not in positions and d.turnout not in skip:
-                    out.setdefault(d.turnout, TurnoutPosition(d.position))
-        return out
-
-    # ---- approach locking ------------------------------------------------------------------------------------------
-    def _approach(self, signal: str) -> tuple[str, ...]:
-        """The sections in rear of ``signal`` where a train makes its cleared route approach-locked (接近区段): the
-        rule set gives how many block sections for a home signal, by the kind of line in rear, and how many track
-        sections for the other signals. A signal's own ``approach`` in the station file overrides it."""
-        st = self.st
-        sig = st.signals[signal]
-        if sig.approach:
-            return tuple(sig.approach)
-        rear = st.signal_rear_track(signal)
-        if rear is None:
-            return ()
-        rules = self.rules.approach_locking
-        back = Direction.up if sig.direction is Direction.down else Direction.down
-        line = self._line_in_rear(rear, back) if sig.kind is SignalKind.home else None
-        blocks = line is not None and line.kind.value == "automatic"
-        count = rules.home.get(line.kind.value if line else "none", rules.other) \
-            if sig.kind is SignalKind.home else rules.other
-        out: list[str] = []
-        track, passed = rear, 0
-        while True:
-            sec = st.tracks[track].section
-            if sec not in out:
-                out.append(sec)
-                if not blocks and len(out) >= count:
-                    break
-            near = self.topo.far_node((track, back))
-            if near not in st.joints:
-                break
-            if blocks and any(s.direction is sig.direction for s in st.signals_at(near)):
-                passed += 1
-                if passed >= count:
-                    break
-            track = st.entry_track(near, back)
-        return tuple(out)
-
-    def _line_in_rear(self, track: str, back: Direction) -> Link | None:
-        st = self.st
-        for _ in range(100):
-            near = self.topo.far_node((track, back))
-            if near in st.ends:
-                return next((lk for lk in st.model.links if lk.end == near), None)
-            if near not in st.joints:
-                return None
-            track = st.entry_track(near, back)
-        return None
-
     # ---- one row ----------------------------------------------------------------------------------------------
     def _add(self, routes: dict[str, Route], start: str, kind: Kind, end: str, via: tuple[str, ...], path: Path,
              end_signal: str | None) -> None:
@@ -384,8 +163,8 @@ class _Builder:
             rid = f"{rid}/D"
         turnouts = [RouteTurnout(t, p, "route") for t, p in path.turnouts]
         in_route = {t.id for t in turnouts}
-        driven = self._partners([t.id for t in turnouts], dict(path.turnouts), set())
-        prot, fouling = self._flank(path.tracks, path.turnouts, in_route | set(driven))
+        driven = driven_turnouts(self.st, [t.id for t in turnouts], dict(path.turnouts), set())
+        prot, fouling = self.flank.of(path.tracks, path.turnouts, in_route | set(driven))
         extra = [RouteTurnout(t, p, "driven") for t, p in driven.items()]
         extra += [RouteTurnout(t, p, "protection") for t, p in prot.items()]
         sig = st.signals[start]
@@ -410,14 +189,14 @@ class _Builder:
         leads_into: str | None = None
         run_on: tuple[RunOn, ...] = ()
         if kind == "shunt" and end_signal is None and end not in st.buttons:
-            leads_into, run_on = self._run_on(end_node, path.direction, path.tracks,
-                                              in_route | set(driven) | set(prot))
+            leads_into, run_on = self.run_ons.of(end_node, path.direction, path.tracks,
+                                               in_route | set(driven) | set(prot))
         diamonds = tuple(sorted({d for t in path.tracks for d, _ in st.crossings.get(t, ())}))
         routes[rid] = Route(
             id=rid, kind=kind, category=category, start=start, end=end, via=via, signal=start,
             direction=path.direction, path=path, turnouts=tuple(turnouts + extra), sections=path.sections,
             fouling=tuple({f.section: f for f in reversed(fouling) if f.section not in path.sections}.values())[::-1],
-            approach=self._approach(start), end_node=end_node, end_signal=end_signal, beyond=beyond,
+            approach=approach.sections(st, self.rules, start), end_node=end_node, end_signal=end_signal, beyond=beyond,
             exit_link=exit_link, line_sections=line,
             overlap_sections=basic.sections, overlap_turnouts=basic.turnouts, overlap_release_s=basic.release_s,
             overlap_end=basic.end, diamonds=diamonds, leads_into=leads_into, run_on=run_on,
@@ -463,7 +242,7 @@ class _Builder:
     def _overlap_turnouts(self, turnouts: Sequence[tuple[str, TurnoutPosition]]) -> tuple[RouteTurnout, ...]:
         """An overlap's turnouts with the crossover partners and driven turnouts they take along."""
         lie = dict(turnouts)
-        lie.update(self._partners([t for t, _ in turnouts], lie, set()))
+        lie.update(driven_turnouts(self.st, [t for t, _ in turnouts], lie, set()))
         return tuple(RouteTurnout(t, p, "route") for t, p in lie.items())
 
     def _link_beyond(self, node: str, d: Direction) -> str | None:

@@ -104,12 +104,10 @@ def _through_joints(st: Station, track: str, node_from: str) -> str | None:
         sec = st.tracks[track].section
         if st.sections[sec].safety_line:
             return sec
-        a, b = st.track_ports[track]
-        far = b if a.node == node_from else a
+        far = st.far_end(track, node_from)
         if far.node not in st.joints:
             return None
-        lo, hi = st.joint_tracks(far.node)
-        track, node_from = (hi if lo == track else lo), far.node
+        track, node_from = st.across(far.node, track), far.node
     return None
 
 

@@ -20,7 +20,7 @@ accepted, the aspects lit, the sections shown locked, the track relays):
 - ``overlap-time``: an overlap (延续进路) stays locked for its release time after the train reached the receiving
   track, and the fault release of the overlap or of a station track is never granted.
 
-Each finding is an :class:`~proving.oracle.check.Finding`, reported by the watch beside the oracle's.
+Each finding is an :class:`~liansuo.proving.oracle.records.Finding`, reported by the watch beside the oracle's.
 """
 
 from __future__ import annotations
@@ -29,9 +29,9 @@ from dataclasses import dataclass, field
 
 from liansuo.proving.judge.rules import approach_extent, fault_release_delay, overlap_time, release_delay
 from liansuo.proving.oracle.authority import Tracer
-from liansuo.proving.oracle.check import Finding
 from liansuo.proving.oracle.gradient import beyond, steep_homes
 from liansuo.proving.oracle.lamps import LampReader
+from liansuo.proving.oracle.records import Finding
 from liansuo.proving.oracle.view import FieldView
 from liansuo.rules import RuleSet
 from liansuo.stations.schema import SectionRole, SignalKind

@@ -7,7 +7,8 @@ engine, not the aspect rules (``tests/test_oracle.py`` holds it to that).
 """
 
 from liansuo.proving.oracle.authority import Authority, Tracer
-from liansuo.proving.oracle.check import Finding, Oracle
+from liansuo.proving.oracle.check import Oracle
+from liansuo.proving.oracle.records import Finding
 from liansuo.proving.oracle.watch import SimulationView, Violation, Watch
 
 __all__ = ["Authority", "Finding", "Oracle", "SimulationView", "Tracer", "Violation", "Watch"]

@@ -18,91 +18,20 @@ authorities meet, reopening a signal) is reported at once.
 from __future__ import annotations
 
 from collections.abc import Iterable
-from dataclasses import dataclass
 
-from liansuo.proving.oracle.authority import Authority, Tracer
-from liansuo.proving.oracle.ceiling import Ceiling, permits
-from liansuo.proving.oracle.flank import Demand, Flank, clearance_m
-from liansuo.proving.oracle.lamps import UNDEFINED, LampReader
-from liansuo.proving.oracle.meet import Extent, head_on, shared
+from liansuo.proving.oracle.authority import Authority
+from liansuo.proving.oracle.ceiling import permits
+from liansuo.proving.oracle.flank import Demand
+from liansuo.proving.oracle.lamps import UNDEFINED
+from liansuo.proving.oracle.meet import head_on, shared
+from liansuo.proving.oracle.records import Finding, Held, InUse
+from liansuo.proving.oracle.tables import Tables
 from liansuo.proving.oracle.view import FieldView
 from liansuo.rules import RuleSet
-from liansuo.stations.schema import Direction, SectionRole, SignalKind
+from liansuo.stations.schema import SectionRole, SignalKind
 from liansuo.stations.station import Station
 
 TURNOUT_AREA_M = 40.0  # wheelsets this close to a turnout's point stand on its switch panel
-
-
-@dataclass(frozen=True)
-class Finding:
-    key: str  # the same key is the same finding; it is reported once while it lasts
-    prop: str  # shared, head-on, turnout, flank, clear, aspect, doors, reopened, moved, lamps, invisible
-    text: str
-    hazard: bool = False
-    delayed: bool = False  # caused by the world: the interlocking has some cycles to answer
-
-
-@dataclass
-class InUse:
-    """An authority whose signal has closed behind the movement that entered it."""
-
-    auth: Authority
-    seen: list[bool]  # each path section has been occupied
-    pre: set[int]  # sections already occupied before the movement entered (a red band under a guide aspect)
-    passed: int = 0  # sections[:passed] are behind the movement
-    reached_at: float | None = None  # the last path section was first occupied (starts the overlap time)
-    operator: bool = False  # it was a guided movement the operator answers for (guide total lock)
-    guided: bool = False  # it entered on the guide aspect: at sight, with no overlap beyond its end
-
-    @property
-    def sections(self) -> list[str]:
-        return self.auth.sections
-
-
-@dataclass
-class _Held(Extent):
-    """An extent with what this check found about its turnouts."""
-
-    unsettled: bool = False  # a turnout of it is not where it should be (the world's doing, being answered)
-    operator: bool = False  # a guide aspect over turnouts without indication: the operator answers for the route
-    guided: bool = False  # a guide aspect: its track circuits are not checked, the operator has looked at the way
-    in_use: bool = False  # a movement under way (its signal has closed behind it)
-    guided_in: bool = False  # under way, entered on a guide aspect
-
-
-class Tables:
-    """What the oracle reads of a station and a rule set, worked out once per station and rule set for every oracle
-    watching a simulation of it (verify starts thousands): the tracer, the ceiling, the lamp reader and the indices
-    below never change once made (the reader's memo is a pure function of the lamps it was asked about). The flank
-    is the one piece each oracle has of its own (``Flank.fresh``): its memo is keyed by a path's tracks alone."""
-
-    def __init__(self, station: Station, rules: RuleSet) -> None:
-        self.tracer = Tracer(station, overlap_release_s=rules.overlap_release_s, rules=rules)
-        self.flank = Flank(station, clearance_m(station, rules))
-        self.reader = LampReader(rules.aspects)
-        self.ceiling = Ceiling(station, rules)
-        self.onto_track = {frozenset(pair) for pair in rules.enemy_onto_track}
-        self.kind = {s.id: s.kind for s in station.model.signals}
-        self.lamps = {s.id: {lamp.value for lamp in s.lamps} for s in station.model.signals}
-        self.rear: dict[str, str | None] = {}
-        for s in station.model.signals:
-            rear = station.signal_rear_track(s.id)
-            self.rear[s.id] = station.tracks[rear].section if rear else None
-        self.doors = {p.section for p in station.model.platforms if p.screen_doors}
-        self.role = {s: sec.role for s, sec in station.sections.items()}
-        self.section_of = {t: tr.section for t, tr in station.tracks.items()}
-        self.turnout_section = dict(station.turnout_section)
-        self.turnout_sections = sorted(set(self.turnout_section.values()))  # each once (a crossover's share one)
-        self.turnout_tracks = {t: {tid for _, tid in station.node_tracks[t]} for t in station.turnouts}
-        self.pair_of = {t.id: t.pair for t in station.model.turnouts if t.pair}
-        # automatic lines: their sections, and the direction that leads out of the station onto them
-        self.lines: dict[str, tuple[frozenset[str], Direction]] = {}
-        for lk in station.model.links:
-            if lk.kind.value == "automatic" and lk.sections:
-                first = station.section_tracks[lk.sections[0]]
-                inside = sum(station.node_at(p.node) for t in first for p in station.track_ports[t]) / (2 * len(first))
-                out = Direction.down if station.node_at(lk.end) > inside else Direction.up
-                self.lines[lk.id] = (frozenset(lk.sections), out)
 
 
 class Oracle:
@@ -176,7 +105,7 @@ class Oracle:
         self.now = now
         found: dict[str, Finding] = {}
         shown = self._read(view, showing, found)
-        held: list[_Held] = []
+        held: list[Held] = []
         for sig, aspect in shown.items():
             a = self.open[sig]
             held.append(self._judge_open(sig, aspect, a, view, shown, found))
@@ -262,13 +191,13 @@ class Oracle:
 
     # ---- an open authority -------------------------------------------------------------------------------------------
     def _judge_open(self, sig: str, aspect: str, a: Authority, view: FieldView, shown: dict[str, str],
-                    found: dict[str, Finding]) -> _Held:
+                    found: dict[str, Finding]) -> Held:
         guide = aspect == self.aspects.guide
         if not self._repertoire(sig, aspect):
             found[f"aspect:{sig}"] = Finding(f"aspect:{sig}", "aspect", f"{self.kind[sig].value} signal {sig} shows "
                                              f"{aspect}, which it never may", delayed=True)
         demands, fouling = self.flank.of(a.tracks, a.turnouts)
-        h = _Held(sig, a, set(a.all_sections), set(a.sections), set(a.overlap_sections), set(a.diamonds),
+        h = Held(sig, a, set(a.all_sections), set(a.sections), set(a.overlap_sections), set(a.diamonds),
                   set(fouling))
         # a guide aspect over turnouts without indication, or under guide total lock (引导总锁闭, where the
         # interlocking checks no route by design): the operator has checked the way by sight and answers for the
@@ -415,8 +344,8 @@ class Oracle:
         self.in_use.append(InUse(a, [bool(v) and i not in pre for i, v in enumerate(seen)], pre, operator=operator,
                                  guided=guided))
 
-    def _in_use(self, view: FieldView) -> list[_Held]:
-        out: list[_Held] = []
+    def _in_use(self, view: FieldView) -> list[Held]:
+        out: list[Held] = []
         keep: list[InUse] = []
         for u in self.in_use:
             secs = u.sections
@@ -453,7 +382,7 @@ class Oracle:
             rem = set(remaining)
             tracks = [t for t in a.tracks if self.section_of[t] in rem]
             turnouts = {t: p for t, p in a.turnouts.items() if self.turnout_section.get(t) in rem}
-            h = _Held(f"{a.signal} (in use)", a, rem | (set(a.overlap_sections) if overlap_held else set()), rem,
+            h = Held(f"{a.signal} (in use)", a, rem | (set(a.overlap_sections) if overlap_held else set()), rem,
                       set(a.overlap_sections) if overlap_held else set(),
                       {d for t in tracks for d, _ in self.st.crossings.get(t, ())}, operator=u.operator, in_use=True,
                       guided_in=u.guided)
@@ -471,7 +400,7 @@ class Oracle:
         return out
 
     # ---- across authorities ------------------------------------------------------------------------------------------
-    def _across(self, held: list[_Held], found: dict[str, Finding]) -> None:
+    def _across(self, held: list[Held], found: dict[str, Finding]) -> None:
         by_element: dict[str, list[int]] = {}
         for i, h in enumerate(held):
             for e in [*h.sections, *h.fouling, *(f"diamond {d}" for d in h.diamonds)]:
@@ -504,7 +433,7 @@ class Oracle:
                 found[key] = Finding(key, "head-on", f"{a.name} ({a.auth.kind}) and {b.name} ({b.auth.kind}) lead "
                                      f"head-on onto {track}", hazard=hazard, delayed=delayed)
 
-    def _lines(self, held: list[_Held], view: FieldView, found: dict[str, Finding]) -> None:
+    def _lines(self, held: list[Held], view: FieldView, found: dict[str, Finding]) -> None:
         """An automatic line is worked one way at a time: no signal may give a train out onto it while another gives
         one in from it (a home or block signal facing the station, its section in rear on the line, route or guide
         aspect alike), nor receive a train from it while its direction is set for departures (改方). A shunting
@@ -525,9 +454,9 @@ class Oracle:
                 found[key] = Finding(key, "line", f"line {link} is set for departures from this station (改方) while "
                                      f"signal {coming[0]} gives a movement in from it", delayed=True)
 
-    def _moving(self, view: FieldView, held: list[_Held], found: dict[str, Finding]) -> None:
+    def _moving(self, view: FieldView, held: list[Held], found: dict[str, Finding]) -> None:
         moving = {t: view.target(t) for t in view.moving()}
-        needs: dict[str, list[tuple[_Held, str, str]]] = {}
+        needs: dict[str, list[tuple[Held, str, str]]] = {}
         for h in held:
             for t, (pos, role) in h.needed.items():
                 needs.setdefault(t, []).append((h, pos, role))

@@ -132,8 +132,7 @@ class Flank:
         while True:
             if track in path or self.role[track] not in _WALKABLE:
                 return None
-            a, b = st.track_ports[track]
-            far = b if a.node == node_from else a
+            far = st.far_end(track, node_from)
             if far.leg is not None:
                 return far.node, far.leg
             if far.node not in st.joints:
@@ -141,8 +140,7 @@ class Flank:
             towards_path = Direction.up if st.node_at(far.node) > st.node_at(node_from) else Direction.down
             if any(s.direction is towards_path for s in st.signals_at(far.node)):
                 return None
-            lo, hi = st.joint_tracks(far.node)
-            track, node_from = (hi if lo == track else lo), far.node
+            track, node_from = st.across(far.node, track), far.node
 
     def _leads_into(self, track: str, node_from: str, path: set[str], crossing: set[str]) -> bool:
         """Does a movement leaving turnout ``node_from`` along ``track`` reach the path (or a track crossing it)
@@ -151,12 +149,10 @@ class Flank:
         while True:
             if track in path or track in crossing:
                 return True
-            a, b = st.track_ports[track]
-            far = b if a.node == node_from else a
+            far = st.far_end(track, node_from)
             if far.leg is not None or far.node not in st.joints:
                 return False
-            lo, hi = st.joint_tracks(far.node)
-            track, node_from = (hi if lo == track else lo), far.node
+            track, node_from = st.across(far.node, track), far.node
 
     def _fouling(self, track: str, turnout: str) -> str | None:
         """The section past the first joint on a free leg, when that joint lies inside the turnout's fouling limit:
@@ -165,12 +161,10 @@ class Flank:
         st = self.st
         node_from = turnout
         while True:
-            a, b = st.track_ports[track]
-            far = b if a.node == node_from else a
+            far = st.far_end(track, node_from)
             if far.leg is not None or far.node not in st.joints:
                 return None
-            lo, hi = st.joint_tracks(far.node)
-            beyond = hi if lo == track else lo
+            beyond = st.across(far.node, track)
             if st.tracks[beyond].section != st.tracks[track].section:
                 inside = abs(st.node_at(far.node) - st.node_at(turnout)) < self.limit.get(turnout, 0.0)
                 return st.tracks[beyond].section if beyond in self.fouled or inside else None

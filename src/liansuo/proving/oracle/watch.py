@@ -12,7 +12,8 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-from liansuo.proving.oracle.check import Finding, Oracle
+from liansuo.proving.oracle.check import Oracle
+from liansuo.proving.oracle.records import Finding
 from liansuo.rules import RuleSet
 from liansuo.simulation.language import split_words
 
