@@ -15,17 +15,13 @@ from liansuo.proving.verify.probe import (
     prepare,
     route_line,
 )
-from liansuo.proving.verify.routecheck import RouteCheck
+from liansuo.proving.verify.routecheck import RouteItems
 from liansuo.proving.verify.signalchecks import SignalChecks, door_platforms
 from liansuo.stations.schema import SignalKind
 
 
-class ReleaseChecks:
-    def __init__(self, rt: RouteCheck) -> None:
-        self.rt = rt
-        self.ctx = rt.ctx
-        self.r = rt.r
-        self.st = rt.ctx.station
+class ReleaseChecks(RouteItems):
+    """The release items: cancel, time release, sequential release, fault release, overlap, guide."""
 
     def run(self) -> None:
         self.cancel()
@@ -37,9 +33,6 @@ class ReleaseChecks:
         self.guide()
         self.guide_route()
         SignalChecks(self.rt).run()
-
-    def na(self, what: str) -> None:
-        self.rt.res.not_applicable.append(what)
 
     def approached(self) -> Probe | None:
         """A probe with the route's signal open and a train standing in its approach, or None (the route's failure

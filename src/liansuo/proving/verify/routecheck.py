@@ -97,3 +97,17 @@ class RouteCheck:
         if ok:
             self.res.aspects_seen.add(p.aspect(self.r.signal))
         return self.check(ok, check, f"signal {self.r.signal} did not open: {p.blocker(self.r)}", p)
+
+
+class RouteItems:
+    """A group of the items of one route's test, run on its :class:`RouteCheck` ``rt``."""
+
+    def __init__(self, rt: RouteCheck) -> None:
+        self.rt = rt
+        self.ctx = rt.ctx
+        self.r = rt.r
+        self.st = rt.ctx.station
+
+    def na(self, what: str) -> None:
+        """An item that does not apply to this route, and why."""
+        self.rt.res.not_applicable.append(what)

@@ -8,7 +8,7 @@ from functools import partial
 from liansuo.interlocking.aspects import is_open
 from liansuo.interlocking.table.build import Route
 from liansuo.proving.verify.probe import Failure, Probe, against_running, open_route, route_line
-from liansuo.proving.verify.routecheck import RouteCheck
+from liansuo.proving.verify.routecheck import RouteItems
 from liansuo.stations.schema import Link
 from liansuo.stations.station import Station
 
@@ -21,20 +21,13 @@ def door_platforms(st: Station, r: Route) -> list[str]:
             and (pl.section in r.sections or pl.section == rear_section)]
 
 
-class SignalChecks:
-    def __init__(self, rt: RouteCheck) -> None:
-        self.rt = rt
-        self.ctx = rt.ctx
-        self.r = rt.r
-        self.st = rt.ctx.station
+class SignalChecks(RouteItems):
+    """The signal's items: its lamps, the screen doors, the aspects with the onward routes set."""
 
     def run(self) -> None:
         self.lamps()
         self.doors()
         self.aspects()
-
-    def na(self, what: str) -> None:
-        self.rt.res.not_applicable.append(what)
 
     def lamps(self) -> None:
         """A lamp of the aspect shown goes dark (both filaments): the interlocking commands a more restrictive
