@@ -36,8 +36,7 @@ STAGES: dict[RouteStage, tuple[str, frozenset[RouteStage]]] = {
     _S.locked: ("_locked", frozenset({_S.open, _S.guide, _S.in_use})),  # conditions hold; guide; entered at danger
     _S.open: ("_keep_open", frozenset({_S.in_use, _S.closed, _S.time_release})),  # entered; lost; release (总人解)
     _S.guide: ("_keep_guide", frozenset({_S.in_use, _S.closed, _S.time_release})),  # entered; lost or unused; release
-    _S.closed: ("_closed", frozenset({_S.open, _S.guide, _S.in_use, _S.time_release})),  # reopen; guide; entered;
-    # release
+    _S.closed: ("_closed", frozenset({_S.open, _S.guide, _S.in_use, _S.time_release})),  # reopen; guide; in; release
     _S.in_use: ("_sequential_release", frozenset()),  # releases section by section, then finish
     _S.time_release: ("_time_release", frozenset({_S.in_use})),  # a movement entered; else finish after the delay
 }
