@@ -6,7 +6,7 @@ STAMP := $(VENV)/.installed
 
 .PHONY: run test lint clean native test-native
 
-# Reinstall only when pyproject.toml changed since the last install. The sumo extra (libsumo, eclipse-sumo, about
+# Reinstall only when pyproject.toml or setup.py changed since the last install. The sumo extra (libsumo, eclipse-sumo, about
 # 230 MB) is installed too where it can be; where it cannot, the SUMO engine's tests skip and say why.
 $(STAMP): pyproject.toml setup.py
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
