@@ -6,8 +6,9 @@ STAMP := $(VENV)/.installed
 
 .PHONY: run test lint clean native test-native
 
-# Reinstall only when pyproject.toml or setup.py changed since the last install. The sumo extra (libsumo, eclipse-sumo, about
-# 230 MB) is installed too where it can be; where it cannot, the SUMO engine's tests skip and say why.
+# Reinstall only when pyproject.toml or setup.py changed since the last install. The sumo extra (libsumo,
+# eclipse-sumo, about 230 MB) is installed too where it can be; where it cannot, the SUMO engine's tests skip and say
+# why.
 $(STAMP): pyproject.toml setup.py
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
