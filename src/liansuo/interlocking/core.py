@@ -16,14 +16,13 @@ from collections.abc import Iterable
 from liansuo.interlocking.aspects import downgrade, is_open, onward_allows_usu, select_aspect
 from liansuo.interlocking.autoblock import cab_codes
 from liansuo.interlocking.block64d import BlockLink, line_pulses_in, line_tracks_changed
-from liansuo.interlocking.index import Index
+from liansuo.interlocking.index import Index, guide_area
 from liansuo.interlocking.io import MAX_EVENTS, Alarm, Changes, DoorCommand, Event, Outputs, RelayBoard
 from liansuo.interlocking.locks import Hold, LockLedger
 from liansuo.interlocking.state import GuideOnly, RouteStage, RouteState, SignalState, TurnoutState
 from liansuo.interlocking.stationblock import StationBlockLink
 from liansuo.interlocking.table.route import InterlockingTable, Route
 from liansuo.rules import RuleSet, load_rules
-from liansuo.stations.schema import SectionRole
 from liansuo.stations.station import Station
 
 
@@ -102,6 +101,16 @@ class Core:
 
     def clear(self, section: str) -> bool:
         return self.board.clear(section)
+
+    # ---- what the outputs after the routes follow ---------------------------------------------------------------
+    def routes_changed(self) -> None:
+        """A route was selected, moved stage, released a section or ended, or a signal it gives closed: the cab
+        codes are worked out again at the end of the cycle (``give_outputs``)."""
+        self.codes_dirty = True
+
+    def line_direction_changed(self) -> None:
+        """A line's running direction changed (改方): the cab codes and the automatic block signals follow."""
+        self.codes_dirty = self.blocks_dirty = True
 
     # ---- the cycle: inputs before the routes, outputs after them ----------------------------------------------
     def tick(self, t: float, cycles: int = 1) -> None:
@@ -387,26 +396,7 @@ class Core:
         the tracks that border it (station tracks, spurs, the lines), whichever way its turnouts lie."""
         area = self._guide_areas.get(signal)
         if area is None:
-            st = self.station
-            outside = (SectionRole.station_track, SectionRole.approach, SectionRole.block, SectionRole.departure,
-                       SectionRole.spur)
-            start = st.signal_entry_track(signal)
-            seen, todo = {start}, [start]
-            throat, border = {st.tracks[start].section}, set()
-            while todo:
-                track = todo.pop()
-                for port in st.track_ports[track]:
-                    for _, nxt in st.node_tracks[port.node]:
-                        sec = st.tracks[nxt].section
-                        if nxt in seen or nxt == st.signal_rear_track(signal):
-                            continue
-                        seen.add(nxt)
-                        if st.sections[sec].role in outside:
-                            border.add(sec)
-                        else:
-                            throat.add(sec)
-                            todo.append(nxt)
-            area = self._guide_areas[signal] = (frozenset(throat), frozenset(border))
+            area = self._guide_areas[signal] = guide_area(self.station, signal)
         return area
 
     def guide_only_doors(self, signal: str) -> list[str]:

@@ -126,7 +126,7 @@ class EquipmentCommands:
         else:
             self.core.line_out.discard(link)
             self.core.out.line_direction.pop(link, None)
-        self.core.codes_dirty = self.core.blocks_dirty = True
+        self.core.line_direction_changed()
         word = "set for departures from this station" if want_out else "back to its running direction"
         self.core.event("block", f"line {link} {word} (改方)")
         return Result.accept(f"line {link} {word}")

@@ -42,3 +42,27 @@ class Index:
             rear = st.signal_rear_track(sig)
             if rear is not None and st.tracks[rear].section in line_of:
                 self.receives_from[sig] = line_of[st.tracks[rear].section]
+
+
+def guide_area(st: Station, signal: str) -> tuple[frozenset[str], frozenset[str]]:
+    """The sections of the throat ``signal`` leads into, and the tracks that border it (station tracks, spurs, the
+    lines), whichever way its turnouts lie: where a train guided from it under guide total lock may go."""
+    outside = (SectionRole.station_track, SectionRole.approach, SectionRole.block, SectionRole.departure,
+               SectionRole.spur)
+    start = st.signal_entry_track(signal)
+    seen, todo = {start}, [start]
+    throat, border = {st.tracks[start].section}, set()
+    while todo:
+        track = todo.pop()
+        for port in st.track_ports[track]:
+            for _, nxt in st.node_tracks[port.node]:
+                sec = st.tracks[nxt].section
+                if nxt in seen or nxt == st.signal_rear_track(signal):
+                    continue
+                seen.add(nxt)
+                if st.sections[sec].role in outside:
+                    border.add(sec)
+                else:
+                    throat.add(sec)
+                    todo.append(nxt)
+    return frozenset(throat), frozenset(border)

@@ -84,12 +84,12 @@ class RouteLifecycle:
         getattr(self, STAGES[rs.stage][0])(rs)
 
     def to(self, rs: RouteState, stage: RouteStage) -> None:
-        """Move ``rs`` to ``stage``, a move :data:`STAGES` lists; the cab codes follow the routes' stages."""
+        """Move ``rs`` to ``stage``, a move :data:`STAGES` lists (the core hears that the routes changed)."""
         if stage not in STAGES[rs.stage][1]:
             raise RuntimeError(f"route {rs.id}: no move from {rs.stage.value} to {stage.value} in the route state "
                                "machine (lifecycle.STAGES)")
         rs.stage = stage
-        self.core.codes_dirty = True
+        self.core.routes_changed()
 
     # ---- selection ----------------------------------------------------------------------------------------------
     def select(self, rs: RouteState) -> None:
@@ -110,7 +110,7 @@ class RouteLifecycle:
         for t in rs.all_turnouts:
             if core.board.indication(t.id) != t.position.value:
                 core.request_move(t.id, t.position.value)
-        core.codes_dirty = True
+        core.routes_changed()
         core.event("route", f"route {r.id} selected")
 
     # ---- stage handlers -----------------------------------------------------------------------------------------
@@ -361,7 +361,7 @@ class RouteLifecycle:
         moves the route on (a train entered, the route is being released)."""
         core, r = self.core, rs.route
         core.out.set_aspect(r.signal, stop_aspect(core.station, r.signal))
-        core.codes_dirty = True
+        core.routes_changed()
         if abnormal:
             self.to(rs, RouteStage.closed)
             core.alarm("closed", r.signal, f"signal {r.signal} closed: {reason}")
@@ -388,7 +388,7 @@ class RouteLifecycle:
     def release_section(self, rs: RouteState, i: int) -> None:
         core, s = self.core, rs.sections[i]
         rs.released[i] = True
-        core.codes_dirty = True
+        core.routes_changed()
         core.locks.unlock_section(s, Hold.route, rs.id)
         for t in rs.turnouts:
             if core.station.turnout_section[t.id] == s:
@@ -416,7 +416,7 @@ class RouteLifecycle:
         if core.by_signal.get(r.signal) == rs.id:
             del core.by_signal[r.signal]
         core.clear_alarm("closed", r.signal)
-        core.codes_dirty = True
+        core.routes_changed()
         core.event("route", f"route {r.id} released")
 
     def release_overlap(self, rid: str) -> None:

@@ -1,7 +1,7 @@
 """What a route's handler read when it last ran (:class:`~.state.RouteMemo`), behind one small interface: the
 route lifecycle (:mod:`.lifecycle`) asks :meth:`Memos.unchanged` whether a route's cycle can be skipped, and hands
 each handler's reads to :meth:`Memos.setting`, :meth:`Memos.open_memo` or :meth:`Memos.release` to be kept. A memo
-is a pure cache: a skipped cycle changes exactly what the handler would have changed, nothing (the suite's
+is a pure cache: a skipped cycle changes what the handler would have changed, which is nothing (the suite's
 tests/test_shortcuts_same.py runs the handler after every skip to hold it to that)."""
 
 from __future__ import annotations
