@@ -100,6 +100,21 @@ def test_each_run_asked_for_is_appended_to_the_history(monkeypatch: pytest.Monke
     assert "give --history a file name" in capsys.readouterr().err
 
 
+def test_a_history_that_is_not_one_is_refused_before_the_run_and_left_as_it_was(
+        monkeypatch: pytest.MonkeyPatch, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    ran: list[bool] = []
+    monkeypatch.setattr(bench, "run_bench", lambda **kw: ran.append(True))
+    station = tmp_path / "station.yaml"
+    station.write_text("id: mine\n", encoding="utf-8")
+    assert main(["bench", "--history", str(station)]) == 3
+    assert capsys.readouterr().err == (f"liansuo bench: {station}:1:1: error: this is not a benchmark history (one "
+                                       "JSON object a line, each with its date); give --history a new file or one "
+                                       "liansuo bench wrote\n")
+    assert main(["bench", "--history", str(tmp_path / "no" / "h.jsonl")]) == 2
+    assert "no folder" in capsys.readouterr().err
+    assert ran == [] and station.read_text(encoding="utf-8") == "id: mine\n"
+
+
 @pytest.mark.parametrize(("turnouts", "tracks"), [(0, 1), (6, 4), (20, 8), (61, 24)])
 def test_generated_hub_is_valid_and_exact(turnouts: int, tracks: int) -> None:
     station = load_text(generate_hub(turnouts, tracks), "<hub>")

@@ -6,17 +6,17 @@ import argparse
 from collections.abc import Callable
 from pathlib import Path
 
-from liansuo.kit.arguments import unwritable
 from liansuo.kit.exitcodes import Exit, refuse
 
 Add = Callable[..., argparse.ArgumentParser]
 
 
 def cmd_bench(args: argparse.Namespace) -> int:
+    from liansuo.bench.history import unfit
     from liansuo.bench.report import main  # the benchmark loads the whole simulation: only when it runs
 
-    if args.history is not None and (why := unwritable(args.history, "--history")):
-        return refuse("bench", why, Exit.USAGE)
+    if args.history is not None and (why := unfit(args.history)):
+        return refuse("bench", why, Exit.BAD_INPUT if why.startswith(str(args.history)) else Exit.USAGE)
     return main(quick=args.quick, fmt=args.format, scale=args.scale, explore=args.explore, history=args.history)
 
 

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import datetime
 import json
+import os
 import subprocess
 from pathlib import Path
 from typing import Any
@@ -26,6 +27,32 @@ def commit() -> str | None:
     except (OSError, subprocess.SubprocessError):
         return None
     return head + ("+" if dirty else "")
+
+
+def unfit(path: Path) -> str:
+    """Why the run's report could not be appended to ``path`` (checked before the run, which may take minutes), or
+    '': a folder that exists and may be written, and a file that is not there yet or holds a history already (each
+    line a JSON object with its ``date``)."""
+    folder = path.parent
+    if path.is_dir():
+        return f"cannot append to {path}: it is a folder; give --history a file name"
+    if not folder.is_dir():
+        return (f"cannot append to {path}: no folder {folder}; create it or give --history a file in a folder that "
+                "exists")
+    if not path.exists():
+        return "" if os.access(folder, os.W_OK) else f"cannot create {path}: the folder {folder} is not writable"
+    if not os.access(path, os.W_OK):
+        return f"cannot append to {path}: the file is not writable"
+    try:
+        with path.open(encoding="utf-8") as f:
+            first = f.readline()
+        entry = json.loads(first) if first.strip() else {"date": ""}
+    except (OSError, UnicodeDecodeError, ValueError):
+        entry = None
+    if not isinstance(entry, dict) or "date" not in entry:
+        return (f"{path}:1:1: error: this is not a benchmark history (one JSON object a line, each with its date); "
+                "give --history a new file or one liansuo bench wrote")
+    return ""
 
 
 def append(path: Path, report: dict[str, Any]) -> None:

@@ -17,6 +17,7 @@ from liansuo.bench.station import measure
 from liansuo.bench.trains import TARGET_RATIO, TARGET_TRAINS, run_trains, trains_text
 from liansuo.bench.zpw import ZPW_TARGET_CONFIGS_PER_S, measure_zpw
 from liansuo.interlocking.table.build import build_table
+from liansuo.kit.exitcodes import Exit, refuse
 from liansuo.kit.fit import fit_all
 from liansuo.kit.jsonreport import print_report
 from liansuo.kit.jsonreport import report as jsonreport
@@ -201,21 +202,30 @@ def main(quick: bool = False, fmt: str = "json", scale: bool = False, explore: b
         figures = measure_explore(ExploreSizes.quick() if quick else ExploreSizes())
         report: dict[str, Any] = {"benchmark": "liansuo explore", "mode": "quick" if quick else "full",
                                   "machine": machine(), "explore": figures}
-        if history is not None:
-            append(history, jsonreport("bench", True, report))
         if fmt == "json":
             print_report("bench", True, report)
         else:
             print(explore_text(figures))
-        return 0
+        return _keep(history, report)
     sizes = (ScaleSizes.quick() if quick else ScaleSizes()) if scale else None
     report = run_bench(quick=quick, scale=sizes, show_progress=None)
-    if history is not None:
-        append(history, jsonreport("bench", True, report))
     if fmt == "json":
         print_report("bench", True, report)  # the figures are reported, never judged: always ok
     else:
         print(as_text(report))
+    return _keep(history, report)
+
+
+def _keep(history: Path | None, report: dict[str, Any]) -> int:
+    """Append the report to the history, if one was asked for; a file that became unwritable during the run is
+    refused with the report already printed."""
+    if history is None:
+        return 0
+    try:
+        append(history, jsonreport("bench", True, report))
+    except OSError as exc:
+        return refuse("bench", f"cannot append to {history}: {exc.strerror or exc}; the report above was not kept",
+                      Exit.BAD_INPUT)
     return 0
 
 
