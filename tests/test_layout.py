@@ -15,7 +15,7 @@ LAYERS = ("kit", "rules", "stations", "circuits", "interlocking", "simulation", 
           "server", "remote", "cli")
 # the floor of each layer: a module imports only from its own layer or from a lower floor (README.md, "Layout")
 FLOOR = {"kit": 0, "rules": 1, "stations": 2, "circuits": 3, "interlocking": 3, "simulation": 4, "classroom": 5,
-         "tui": 6, "server": 6, "proving": 7, "remote": 7, "bench": 8, "cli": 9}
+         "fieldio": 5, "tui": 6, "server": 6, "proving": 7, "remote": 7, "bench": 8, "cli": 9}
 # the classroom (roles, exercises, assessment) stands on the simulation, below the console and the server that both
 # use it; proving stands above the console, whose fuzzer it holds; bench measures what proving runs (verify, soak),
 # so it stands above it; remote (the classroom's clients) puts the console (tui) on the server's seats, so it stands

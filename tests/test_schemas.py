@@ -25,7 +25,8 @@ MODELINE = re.compile(r"^# yaml-language-server: \$schema=(\S+)$")
 # every folder of bundled YAML files of a kind that has a schema, and that kind
 BUNDLED = {"src/liansuo/stations/library": "station", "src/liansuo/examples/stations": "station",
            "src/liansuo/examples/broken": "station", "src/liansuo/examples/scripts": "script",
-           "tests/scripts": "script", "src/liansuo/examples/scenarios": "scenario", "src/liansuo/exercises": "exercise"}
+           "tests/scripts": "script", "src/liansuo/examples/scenarios": "scenario", "src/liansuo/exercises": "exercise",
+           "src/liansuo/examples/points": "points"}
 BUNDLED_FILES = sorted((ROOT / folder / f.name, kind) for folder, kind in BUNDLED.items()
                        for f in (ROOT / folder).glob("*.yaml"))
 

@@ -17,6 +17,7 @@ from liansuo.circuits.phase25 import cli as phase25cli
 from liansuo.circuits.zpw import cli as zpwcli
 from liansuo.classroom import cli as exercise
 from liansuo.cli import completion, schemas
+from liansuo.fieldio import cli as fieldcli
 from liansuo.interlocking.table import cli as interlocking
 from liansuo.kit.jsonreport import version
 from liansuo.proving import cli as proving
@@ -37,7 +38,7 @@ Add = Callable[[str, Handler, str], argparse.ArgumentParser]
 REGISTER: tuple[Callable[[Add], None], ...] = (
     # stations, check, generate
     partial(stations.register, more_warnings=(zpwcli.check_warnings, interlocking.check_warnings),
-            more_errors=(interlocking.check_errors,)),
+            more_errors=(interlocking.check_errors,), points_check=fieldcli.check_points),
     schemas.register,  # schema
     interlocking.register,  # table
     zpwcli.register,  # zpw
@@ -54,6 +55,7 @@ REGISTER: tuple[Callable[[Add], None], ...] = (
     tui.register_replay,  # replay
     exercise.register,  # exercise
     server.register,  # serve
+    fieldcli.register,  # field-sim, field-map
 )
 
 

@@ -30,6 +30,7 @@ KINDS: dict[str, tuple[str, int, str]] = {
     "script": ("liansuo.proving.fileschemas:ScriptFile", 1, "liansuo test script"),
     "scenario": ("liansuo.proving.fileschemas:ScenarioFile", 1, "liansuo scenario"),
     "exercise": ("liansuo.classroom.schema:ExerciseFile", 1, "liansuo exercise"),
+    "points": ("liansuo.fieldio.points:PointMapFile", 1, "liansuo field I/O point map"),
 }
 
 

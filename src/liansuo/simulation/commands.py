@@ -13,6 +13,8 @@ from liansuo.circuits.faults import KINDS, parse_fault
 from liansuo.circuits.railgeometry import Axle
 from liansuo.interlocking.io import Result
 from liansuo.interlocking.table.build import Kind
+from liansuo.simulation.changeover import USAGE as CHANGEOVER_USAGE
+from liansuo.simulation.changeover import changeover
 from liansuo.simulation.language import Command
 from liansuo.simulation.timeparse import parse_duration
 from liansuo.simulation.world import World
@@ -49,6 +51,7 @@ USAGE = {
     "occupy": "occupy SECTION",
     "vacate": "vacate SECTION",
     "run": "run DURATION",
+    "changeover": CHANGEOVER_USAGE,
 }
 
 
@@ -64,8 +67,9 @@ def _route(kind: Kind) -> Handler:
 
 # sealed buttons (铅封按钮), by their command: each accepted use is counted (``World.sealed_uses``). 'guide-lock'
 # counts the locking only (breaking the seal); 'guide-unlock' restores the button. SGA, the 64D accident button, is
-# counted as 'block-line accident'.
-SEALED = ("release", "fault-release", "guide", "guide-lock", "power-up-release", "axle-reset", "block-line accident")
+# counted as 'block-line accident'; QHA, the change-over to field control, as 'changeover'.
+SEALED = ("release", "fault-release", "guide", "guide-lock", "power-up-release", "axle-reset", "block-line accident",
+          "changeover")
 
 
 def _sealed(name: str, handler: Handler) -> Handler:
@@ -287,6 +291,7 @@ _HANDLERS: dict[str, Handler] = {
     "occupy": _one("occupy", _occupy),
     "vacate": _one("vacate", _vacate),
     "run": _run,
+    "changeover": changeover,
 }
 
 WORLD_COMMANDS: tuple[Command[World], ...] = tuple(Command(name, USAGE[name], h) for name, h in _HANDLERS.items())

@@ -13,16 +13,32 @@ Python API::
 from __future__ import annotations
 
 from liansuo.interlocking.io import Result
+from liansuo.simulation.changeover import YARD_WORDS, field_refuses
 from liansuo.simulation.commands import WORLD_COMMANDS
 from liansuo.simulation.diagnosis import DIAGNOSE
 from liansuo.simulation.expect import EXPECT
-from liansuo.simulation.language import Language
+from liansuo.simulation.language import Command, Language
 from liansuo.simulation.trains import ato, automatic
 from liansuo.simulation.trains.commands import TRAIN_COMMANDS
 from liansuo.simulation.trains.fleet import Train
 from liansuo.simulation.world import World
 
-LANGUAGE: Language[Simulation] = Language(WORLD_COMMANDS, [DIAGNOSE], [EXPECT], TRAIN_COMMANDS)
+
+def _yard(c: Command[Simulation]) -> Command[Simulation]:
+    """``c``, refused under field control where it would act on what the field now owns (:mod:`.changeover`)."""
+    if c.name not in YARD_WORDS:
+        return c
+    inner = c.handler
+
+    def handler(sim: Simulation, args: list[str]) -> Result:
+        why = field_refuses(sim, [c.name, *args])
+        return Result.refuse(why) if why else inner(sim, args)
+
+    return Command(c.name, c.usage, handler)
+
+
+LANGUAGE: Language[Simulation] = Language([_yard(c) for c in WORLD_COMMANDS], [DIAGNOSE], [EXPECT],
+                                          [_yard(c) for c in TRAIN_COMMANDS])
 
 
 class Simulation(World):

@@ -9,6 +9,7 @@ from __future__ import annotations
 from liansuo.circuits.field import Field, FieldCommands
 from liansuo.interlocking.io import Outputs, RelayBoard
 from liansuo.rules import RuleSet
+from liansuo.simulation.fieldlink import Elements
 from liansuo.stations.station import Station
 
 
@@ -20,6 +21,7 @@ class Wiring:
         self.commands = FieldCommands()
         self.signal_lamps = station.derived(_signal_lamps)  # read only: shared by every wiring of the station
         self._lit = False  # until every signal is lit at power-on, and again once a restarted interlocking takes over
+        self.remote = Elements()  # under field control: the elements read from the field link, not from here
 
     def power_on(self, board: RelayBoard, out: Outputs) -> None:
         """The station powers on: the field, as built, lights every signal at the aspect ``out`` commands (lamps
@@ -68,21 +70,31 @@ class Wiring:
         return self._lit and not out.changed_signals and not out.axle_resets
 
     def publish(self, board: RelayBoard, everything: bool = False) -> None:
+        """Copy the field's changed relays (``everything``: all its relays) onto ``board``, except those of the
+        elements under field control (``remote``)."""
         f = self.field
         ch = f.take_changes()
+        far = self.remote
         tracks = self.station.sections if everything else ch.tracks
         for s in tracks:
-            board.set_track(s, f.track_up(s))
+            if s not in far.tracks:
+                board.set_track(s, f.track_up(s))
         for t in (self.station.turnouts if everything else ch.turnouts):
+            if t in far.turnouts:
+                continue
             dbj, fbj = f.indication(t)
             board.set_turnout(t, dbj, fbj)
         for sig in (self.station.signals if everything else ch.signals):
+            if sig in far.signals:
+                continue
             for lamp in self.signal_lamps[sig]:
                 board.set_lamp(sig, lamp, f.lamp_proven(sig, lamp))
             if sig in f.flashers:
                 board.set_flasher(sig, f.flasher_ok(sig))
             board.set_filament_alarm(sig, f.filament_alarm(sig))
         for key in (f.doors if everything else ch.doors):
+            if key in far.doors:
+                continue
             pdkj, pdqcj = f.doors_relays(key)
             board.set_doors(key, pdkj, pdqcj)
 

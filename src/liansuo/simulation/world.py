@@ -15,12 +15,13 @@ import weakref
 from collections import deque
 from pathlib import Path
 
-from liansuo.circuits.field import Field
+from liansuo.circuits.field import Field, FieldCommands
 from liansuo.circuits.railgeometry import Axle
 from liansuo.interlocking.cbi import Interlocking
 from liansuo.interlocking.io import Event, Result
 from liansuo.interlocking.table.build import InterlockingTable, build_table
 from liansuo.rules import RuleSet, load_rules
+from liansuo.simulation.fieldlink import Elements, FieldControl, FieldLink
 from liansuo.simulation.neighbour import Neighbours
 from liansuo.simulation.trains.cabsignal import ATP
 from liansuo.simulation.trains.engine import MotionEngine
@@ -57,13 +58,14 @@ class World:
         self.events: deque[Event] = deque(maxlen=20_000)  # the world's own events: trains, faults
         self.alarms: dict[str, str] = {}  # the world's alarms (derailment, squeeze by a train)
         self.sealed: dict[str, int] = {}  # sealed button (铅封) -> its accepted uses (see ``sealed_uses``)
+        self.control: FieldControl | None = None  # the change-over to field equipment, once a link is attached
         for reason in self.field.held_down().values():  # sections past their track-circuit model's range
             self.log("alarm", reason)
         motion = make_engine(engine, self.station, cycle_s)
         # what the fleet calls back does not keep the world alive: a dropped world is freed at once, not by the
         # garbage collector (verify drops thousands of simulations)
         me = weakref.proxy(self)
-        self.fleet = Fleet(self.station, self.field, lambda: me.view.outputs.signals,
+        self.fleet = Fleet(self.station, self.field, lambda: me.driver_aspects(),
                            lambda kind, text: me.log(kind, text), lambda train: me.auto_limit(train),
                            engine=motion, rules=self.rules)
         attach_engine(motion, self.fleet)
@@ -76,9 +78,12 @@ class World:
             self.fleet.step(self.cycle_s)
             self.after_move()
             self.update_axles()
-        self.field.step(self.cycle_s, self.wiring.commands_from(self.view.outputs))
+        commands = self.wiring.commands_from(self.view.outputs)
+        if self.field_control:
+            self._exchange(commands)  # before the simulated field takes the commands it consumes (axle resets)
+        self.field.step(self.cycle_s, commands)
         self.t = round(self.t + self.cycle_s, 9)
-        self.neighbours.step(self.t, self.view.outputs.line_out, self.field.track_up)
+        self.neighbours.step(self.t, self.view.outputs.line_out, self.track_up)
         self.publish()
         self.interlocking.cycle(self.t)
 
@@ -89,11 +94,11 @@ class World:
         everything each time. Returns how many cycles it ran: 0 when the next cycle does more."""
         il = self.interlocking
         quiet = il.quiet
-        if quiet is None or not il.skip_quiet or self.fleet.trains or limit <= 0:
-            return 0
+        if quiet is None or not il.skip_quiet or self.fleet.trains or limit <= 0 or self.field_control:
+            return 0  # under field control every cycle exchanges with the field (its heartbeat)
         out = self.view.outputs
         if not self.wiring.at_rest(out) or il.core.board.pending() \
-                or not self.neighbours.rests(out.line_out, self.field.track_up):
+                or not self.neighbours.rests(out.line_out, self.track_up):
             return 0
         n = self.field.rest_steps(self.cycle_s, self.wiring.commands, limit)
         due = self.neighbours.next_due()
@@ -118,6 +123,45 @@ class World:
         self.wiring.publish(self.view.inputs)
         self.neighbours.publish(self.view.inputs)
 
+    # ---- field control (现场控制): fieldlink.py, changeover.py -----------------------------------------------------
+    def attach_field(self, link: FieldLink) -> None:
+        """Wire a field link behind the change-over relay QHJ; the station stays in simulated control until the
+        change-over (``changeover field``)."""
+        if self.control is not None:
+            self.control.link.close()
+        self.control = FieldControl(link, self.wiring.signal_lamps, set(self.field.flashers))
+
+    @property
+    def field_control(self) -> bool:
+        """QHJ is up: the link's elements are read from and driven in the field."""
+        return self.control is not None and self.control.up
+
+    def track_up(self, section: str) -> bool:
+        """The track relay as wired now: the field's under field control, the simulated field's otherwise."""
+        if self.control is not None and self.control.up and section in self.control.elements.tracks:
+            return self.view.inputs.clear(section)
+        return self.field.track_up(section)
+
+    def switch_control(self, field: bool) -> None:
+        """Pick QHJ up (``field``) or let it drop, and read every relay as now wired. The checks that it is safe
+        are the change-over command's (:mod:`.changeover`)."""
+        assert self.control is not None
+        self.control.up = field
+        self.wiring.remote = self.control.elements if field else Elements()
+        if field:
+            self._log_event(self.control.refresh(self.view.inputs))
+        else:
+            self.control.lost = ""
+            self.wiring.publish(self.view.inputs, everything=True)
+
+    def _exchange(self, commands: FieldCommands) -> None:
+        assert self.control is not None
+        self._log_event(self.control.exchange(commands, self.view.inputs))
+
+    def _log_event(self, event: tuple[str, str] | None) -> None:
+        if event is not None:
+            self.log(*event)
+
     def restart_interlocking(self) -> Result:
         """The interlocking loses power and starts again (全站停电恢复): every route and lock is forgotten, every signal
         closes, and the station stays locked (上电锁闭) until the operator's power-up release. The field keeps what
@@ -126,6 +170,8 @@ class World:
         self.view = InterlockingView(self.interlocking)
         self.wiring.relight()
         self.wiring.publish(self.view.inputs, everything=True)
+        if self.control is not None and self.control.up:
+            self._log_event(self.control.refresh(self.view.inputs))
         self.neighbours.publish(self.view.inputs)
         self.interlocking.cycle(self.t)
         self.log("power", "interlocking restarted: the station is locked until the power-up release (上电解锁)")
@@ -133,8 +179,11 @@ class World:
                              "'power-up-release' (上电解锁)")
 
     def close(self) -> None:
-        """Release what the train engine holds (the SUMO worker process); the kinematic engine holds nothing."""
+        """Release what the train engine holds (the SUMO worker process; the kinematic engine holds nothing) and
+        the field link."""
         self.fleet.engine.close()
+        if self.control is not None:
+            self.control.link.close()
 
     # ---- wheelsets, doors, the log ------------------------------------------------------------------------------
     def place_axles(self, name: str, axles: list[Axle]) -> None:
@@ -171,6 +220,11 @@ class World:
 
     def after_move(self) -> None:
         """What happens on board after the trains moved (the ATO's platform doors)."""
+
+    def driver_aspects(self) -> dict[str, str]:
+        """The aspects the drivers see: what the interlocking commands (the field simulator's, what its lamps
+        show)."""
+        return self.view.outputs.signals
 
     # ---- queries: each raises UnknownId (a KeyError) for an id the station does not have ---------------------------
     def aspect(self, signal: str) -> str:

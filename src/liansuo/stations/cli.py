@@ -21,6 +21,8 @@ from liansuo.stations.summary import summarise, summary_text
 Add = Callable[..., argparse.ArgumentParser]
 FORMATS = ("text", "json")
 Warnings = Callable[[Station], list[Diagnostic]]
+# a station's field I/O point map checked against it (fieldio/cli.py): every problem, and what the map wires
+PointsCheck = Callable[[Station, str], tuple[list[Diagnostic], str]]
 
 
 def cmd_stations(args: argparse.Namespace) -> int:
@@ -51,10 +53,19 @@ def cmd_check(args: argparse.Namespace) -> int:
         return bad_input(exc)
     for more in args.more_warnings:  # checks of the layers above, handed in by the command line (cli/main.py)
         station.warnings = [*station.warnings, *more(station)]
+    wired = ""
+    if getattr(args, "points", None):
+        found, wired = args.points_check(station, args.points)
+        errors = [d for d in found if d.severity == "error"]
+        if errors:
+            if args.format == "json":
+                print_report("check", False, {"station": args.station, "errors": [d.as_dict() for d in errors]})
+            return bad_input(StationError(errors), "point map")
+        station.warnings = [*station.warnings, *found]
     if args.format == "json":
-        print_report("check", True, summarise(station))
+        print_report("check", True, {**summarise(station), **({"points": wired} if wired else {})})
     else:
-        print(summary_text(station))
+        print(summary_text(station) + (f"\npoint map {args.points}: {wired}" if wired else ""))
     return 0
 
 
@@ -86,17 +97,23 @@ def cmd_generate(args: argparse.Namespace) -> int:
     return 0
 
 
-def register(add: Add, more_warnings: tuple[Warnings, ...] = (), more_errors: tuple[Warnings, ...] = ()) -> None:
+def register(add: Add, more_warnings: tuple[Warnings, ...] = (), more_errors: tuple[Warnings, ...] = (),
+             points_check: PointsCheck | None = None) -> None:
     """Add ``stations``, ``check`` and ``generate``; ``more_warnings``: design checks of higher layers that
     ``check`` adds to the station's own (the track-circuit physics: ``circuits/zpw/cli.py``); ``more_errors``: what
     higher layers refuse in a station that loaded (the interlocking table: ``interlocking/table/cli.py``), so that
-    ``check`` accepts only what every command accepts."""
+    ``check`` accepts only what every command accepts; ``points_check``: ``check --points FILE``, a field I/O point
+    map checked against the station (``fieldio/cli.py``)."""
     sp = add("stations", cmd_stations, "list the bundled stations")
     sp.add_argument("--format", choices=FORMATS, default="text", help="text (default) or json")
     sp = add("check", cmd_check, "validate a station file and summarise it")
     sp.set_defaults(more_warnings=more_warnings, more_errors=more_errors)
     sp.add_argument("station", help="bundled station name or path to a station YAML file")
     sp.add_argument("--format", choices=FORMATS, default="text", help="text (default) or json")
+    if points_check is not None:
+        sp.set_defaults(points_check=points_check)
+        sp.add_argument("--points", metavar="FILE", help="also check this field I/O point map against the station "
+                                                         "(docs/field-mode.md)")
     sp = add("generate", cmd_generate, "write a generated station file (a hub of any size, for stress tests)")
     sp.add_argument("kind", choices=("hub",), help="what to generate: 'hub', a double-ended yard of parallel tracks")
     sp.add_argument("--turnouts", type=positive_int, required=True, metavar="N", help="turnouts in the hub")
