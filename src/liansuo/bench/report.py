@@ -10,6 +10,7 @@ from pathlib import Path
 from typing import Any
 
 from liansuo.bench.busy import BUSY_ROUTES
+from liansuo.bench.field import measure_field
 from liansuo.bench.history import append
 from liansuo.bench.machine import machine
 from liansuo.bench.scale import ScaleSizes, measure_scale
@@ -50,15 +51,16 @@ class Sizes:
     zpw_repeats: int = 10  # vectorised ZPW-2000A sweeps timed
     train_cycles: int = 4800  # trains moving on the hub, each engine (trains.py); 0 skips it
     train_slots: int = 10
+    field_cycles: int = 2000  # jiaopei in field control against field-sim (field.py); 0 skips it
 
     @staticmethod
     def quick() -> Sizes:
-        return Sizes(idle_cycles=1000, busy_cycles=2400, zpw_repeats=3, train_cycles=1200)
+        return Sizes(idle_cycles=1000, busy_cycles=2400, zpw_repeats=3, train_cycles=1200, field_cycles=400)
 
     @staticmethod
     def tiny() -> Sizes:
         return Sizes(hub_turnouts=20, hub_tracks=8, idle_cycles=20, busy_cycles=120, small_factor=1,
-                     warmup_limit=400, zpw_repeats=1, train_cycles=240, train_slots=2)
+                     warmup_limit=400, zpw_repeats=1, train_cycles=240, train_slots=2, field_cycles=0)
 
 
 def _check_targets(results: dict[str, dict[str, Any]]) -> list[dict[str, Any]]:
@@ -81,7 +83,7 @@ def run_bench(sizes: Sizes | None = None, *, quick: bool = False, stations: tupl
     also the figures of :mod:`.scale` (verify, soak and the table at hub size). ``show_progress``: a bar of the
     parts on stderr (None: when it is a terminal)."""
     sizes = sizes or (Sizes.quick() if quick else Sizes())
-    parts = len(stations) + 2 + (scale is not None)
+    parts = len(stations) + 3 + (scale is not None)
     with progress("bench", parts, show=show_progress) as advance:
         return _run(sizes, quick, stations, scale, advance)
 
@@ -108,6 +110,8 @@ def _run(sizes: Sizes, quick: bool, stations: tuple[str, ...], scale: ScaleSizes
     advance(1)
     trains = _trains(sizes) if "hub" in stations and sizes.train_cycles > 0 else None
     advance(1)
+    field = measure_field(sizes.field_cycles) if sizes.field_cycles > 0 else None
+    advance(1)
     targets = _check_targets(results)
     targets.append({"station": "zpw", "figure": "zpw_configs_per_s", "target": f">= {ZPW_TARGET_CONFIGS_PER_S:g}",
                     "value": zpw["zpw_configs_per_s"], "met": zpw["zpw_configs_per_s"] >= ZPW_TARGET_CONFIGS_PER_S})
@@ -129,6 +133,7 @@ def _run(sizes: Sizes, quick: bool, stations: tuple[str, ...], scale: ScaleSizes
         "results": results,
         "zpw": zpw,
         **({"trains": trains} if trains is not None else {}),
+        **({"field": field} if field is not None else {}),
         **({"scale": scaled} if scaled is not None else {}),
         "targets": targets + [{"station": "hub", **t} for t in (scaled or {}).get("targets", [])],
         "total_s": round(time.perf_counter() - start, 2),
@@ -182,6 +187,12 @@ def as_text(report: dict[str, Any]) -> str:
                      f"{z['evaluate_us_train64']:.0f} us)")
     if report.get("trains"):
         lines += trains_text(report["trains"])
+    f = report.get("field")
+    if f:
+        lines.append(f"{'field mode':26}" + (f"skipped: {f['skipped']}" if "skipped" in f else
+                     f"{f['field_cycles_per_s']:.0f} cycles/s on {f['station']} over {f['transport']} "
+                     f"({f['field_cycle_ms']:.2f} ms a cycle, {f['realtime_factor_field']:.0f}x real time; simulated "
+                     f"control {f['simulated_cycles_per_s']:.0f} cycles/s, {f['ratio_simulated_to_field']:.1f}x)"))
     sc = report.get("scale")
     if sc:
         lines.append("scale:")

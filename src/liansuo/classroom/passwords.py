@@ -11,6 +11,7 @@ import secrets
 from pathlib import Path
 
 ENV = "LIANSUO_INSTRUCTOR_PASSWORD"
+CHANGEOVER_ENV = "LIANSUO_CHANGEOVER_PASSWORD"  # QHA, the change-over to field control (docs/field-mode.md)
 N, R, P = 2**14, 8, 1  # scrypt's cost: about 20 ms and 16 MB a check
 
 
@@ -36,19 +37,21 @@ def matches(password: str, stored: str) -> bool:
     return hmac.compare_digest(got.hex(), digest)
 
 
-def instructor_hash(file: str | Path | None) -> str:
+def instructor_hash(file: str | Path | None, *, whose: str = "instructor", env: str = ENV,
+                    option: str = "--password-file") -> str:
     """The stored hash: the file's first line (a hash; a line that is not one is taken as a password and hashed
-    here), else the environment variable, hashed at once."""
+    here), else the environment variable ``env``, hashed at once. ``whose`` and ``option`` name the password in the
+    messages (the change-over's, QHA's, is another: docs/field-mode.md)."""
     if file is not None:
         path = Path(file)
         try:
             line = path.read_text(encoding="utf-8").strip().splitlines()[0].strip()
         except (OSError, UnicodeDecodeError, IndexError) as exc:
-            raise PasswordError(f"{path}: cannot read the instructor's password ({exc or 'the file is empty'}); "
+            raise PasswordError(f"{path}: cannot read the {whose}'s password ({exc or 'the file is empty'}); "
                                 f"write one with: liansuo serve --hash-password > {path}") from None
         return line if line.startswith("scrypt$") else hash_password(line)
-    plain = os.environ.get(ENV)
+    plain = os.environ.get(env)
     if not plain:
-        raise PasswordError(f"no instructor password: give --password-file FILE (liansuo serve --hash-password "
-                            f"writes one) or set {ENV}")
+        raise PasswordError(f"no {whose} password: give {option} FILE (liansuo serve --hash-password "
+                            f"writes one) or set {env}")
     return hash_password(plain)

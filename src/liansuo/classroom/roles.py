@@ -19,7 +19,7 @@ from liansuo.interlocking.io import Result
 OPERATOR_COMMANDS = frozenset({
     "route", "shunt", "cancel", "release", "fault-release", "reopen", "guide", "guide-lock", "guide-unlock",
     "throw", "lock", "unlock", "block", "unblock", "block-line", "line-direction", "power-up-release", "axle-reset",
-    "diagnose",
+    "diagnose", "changeover",
 })
 
 TRAINEE = "trainee"
@@ -46,6 +46,7 @@ def refusal(role: str, line: str) -> Result | None:
     return Result.refuse(f"'{word}' is not an operator's command: it belongs to the instructor "
                          f"(an operator console has: {', '.join(sorted(OPERATOR_COMMANDS))})")
 
-# The world's events a trainee's console shows: alarms and power (the interlocking's own events, which follow from
-# relay states, are all shown). Faults injected or repaired and trains placed are the instructor's secret.
-TRAINEE_WORLD_EVENTS = frozenset({"alarm", "power"})
+# The world's events a trainee's console shows: alarms, power and the change-over of control (the interlocking's own
+# events, which follow from relay states, are all shown). Faults injected or repaired and trains placed are the
+# instructor's secret.
+TRAINEE_WORLD_EVENTS = frozenset({"alarm", "power", "control"})

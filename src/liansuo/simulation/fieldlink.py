@@ -86,6 +86,9 @@ class FieldLink(Protocol):
         ...
 
 
+RETRY_CYCLES = 3  # a lost link is tried again every fourth cycle (about a second), so a console stays responsive
+
+
 class FieldControl:
     """The change-over relay QHJ and the link behind it: ``up`` is field control."""
 
@@ -96,6 +99,7 @@ class FieldControl:
         self.flashers = flashers
         self.up = False
         self.lost = ""  # why the link is lost; '' while it answers
+        self._quiet = 0  # while lost: cycles to go before the next try (a dead address may take a timeout to tell)
 
     @property
     def mode(self) -> str:
@@ -108,6 +112,10 @@ class FieldControl:
     def exchange(self, commands: FieldCommands, board: RelayBoard) -> tuple[str, str] | None:
         """One cycle's exchange; the relays onto ``board``. Returns an event to log, (kind, text), when the link is
         lost or comes back."""
+        if self.lost and self._quiet > 0:
+            self._quiet -= 1
+            self.fail_safe(board)
+            return None
         try:
             reading = self.link.exchange(commands, live=not self.lost)
         except LinkLost as exc:
@@ -124,6 +132,7 @@ class FieldControl:
 
     def _lost(self, exc: LinkLost, board: RelayBoard) -> tuple[str, str] | None:
         self.fail_safe(board)
+        self._quiet = RETRY_CYCLES
         if self.lost:
             return None
         self.lost = str(exc)

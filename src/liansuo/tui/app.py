@@ -28,6 +28,7 @@ from liansuo.classroom.passwords import ENV, hash_password
 from liansuo.classroom.roles import INSTRUCTOR, TRAINEE, command_word, refusal
 from liansuo.kit.printable import printable
 from liansuo.simulation import Result
+from liansuo.simulation.fieldlink import FieldLink
 from liansuo.simulation.recording.recorder import FileRecorder
 from liansuo.simulation.sim import Simulation
 from liansuo.tui.completion import example_route
@@ -35,6 +36,7 @@ from liansuo.tui.consolesim import ConsoleSim
 from liansuo.tui.describe import describe
 from liansuo.tui.diagram import Diagram
 from liansuo.tui.dialogs import ConfirmScreen, HelpScreen, MenuScreen
+from liansuo.tui.fieldmode import FieldModeControls
 from liansuo.tui.grid import Ref
 from liansuo.tui.incidents import KEY_PREFIX, Incident
 from liansuo.tui.instructor import InstructorPanel
@@ -66,7 +68,7 @@ QUIT_WORDS = ("quit", "exit")  # typed in the command bar, they close the consol
 MUTE_WORDS = {"mute": True, "unmute": False}  # typed in the command bar, they mute or unmute the alarm bell, as m does
 
 
-class ConsoleApp(SafeApp, LessonControls):
+class ConsoleApp(SafeApp, LessonControls, FieldModeControls):
     TITLE = "liansuo 联锁"
     # The console runs its simulation's clock (pause, speed, a typed 'run' in slices); a classroom's client does not:
     # the server runs it (remote/app.py)
@@ -95,10 +97,16 @@ class ConsoleApp(SafeApp, LessonControls):
     def __init__(self, station: str = "jiaopei", *, paused: bool = False, speed: float = 1.0,
                  instructor_password: str | None = None, instructor_hash: str | None = None,
                  record: str | Path | None = None, exercise: str | Path | None = None, cycle_s: float = 0.25,
-                 sim: ConsoleSim | None = None, mute: bool = False) -> None:
+                 sim: ConsoleSim | None = None, mute: bool = False, field: FieldLink | None = None,
+                 changeover_hash: str | None = None) -> None:
+        """``field``: a link to field equipment behind the change-over (docs/field-mode.md); ``changeover_hash``:
+        the change-over password (QHA), hashed, asked before each change-over."""
         super().__init__()
         self.station_ref = station
         self.sim: ConsoleSim = sim if sim is not None else Simulation(station, cycle_s=cycle_s)
+        if field is not None and isinstance(self.sim, Simulation):
+            self.sim.attach_field(field)
+        self.changeover_hash = changeover_hash
         self.operator = ConsoleOperator(self.sim)
         self.paused = paused
         self.speed = speed
@@ -298,6 +306,7 @@ class ConsoleApp(SafeApp, LessonControls):
         counting = self.diagram.frame().countdown if self.diagram.layout_ is not None else {}
         if counting:
             out.append("│ 人解 " + " ".join(f"{s} {n}s" for s, n in sorted(counting.items())) + " ", style="#ffd700")
+        self.control_status(out)
         self.lesson_status(out)
         return out
 
@@ -320,6 +329,12 @@ class ConsoleApp(SafeApp, LessonControls):
             self.log_panel.add(f"{self.sim.t:9.2f} {'refused':8} {line}: {why}", "#ff8080")
             self.say(why, False)
             return Result.refuse(why)
+        if self.asks_password(line, source):
+            return Result.accept("")
+        return self.carry_out_line(line, source)
+
+    def carry_out_line(self, line: str, source: str) -> Result:
+        """Send a line the console has let through: a run in slices, anything else at once."""
         if self.recorder is not None:
             self.recorder.source = source
         try:

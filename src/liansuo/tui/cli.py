@@ -21,6 +21,7 @@ from liansuo.kit.source import StationError
 from liansuo.stations.station import Station
 
 if TYPE_CHECKING:
+    from liansuo.simulation.fieldlink import FieldLink
     from liansuo.simulation.recording.file import Recording
     from liansuo.tui.safeapp import SafeApp
 
@@ -44,6 +45,16 @@ def register(add: Add, connect: Handler | None = None) -> None:
                          "(or a password); else LIANSUO_INSTRUCTOR_PASSWORD; never on the command line, where ps "
                          "shows it")
     sp.add_argument("--mute", action="store_true", help="start with the alarm bell muted (m or 'unmute' turns it on)")
+    fld = sp.add_argument_group("field mode", "the interlocking against field equipment over Modbus TCP "
+                                              "(docs/field-mode.md)")
+    fld.add_argument("--field", metavar="HOST:PORT",
+                     help="the field's Modbus TCP address (an I/O module, a PLC, or 'liansuo field-sim'); the console "
+                          "starts in simulated control and 'changeover field' (QHA) changes over")
+    fld.add_argument("--points", metavar="FILE", help="with --field: the point map (default: the whole station, as "
+                                                     "'liansuo field-map' writes it)")
+    fld.add_argument("--changeover-password-file", metavar="FILE",
+                     help="with --field: QHA's password (a hash from 'liansuo serve --hash-password', or the "
+                          "password); else LIANSUO_CHANGEOVER_PASSWORD")
     room = sp.add_argument_group("classroom", "the console as a client of 'liansuo serve' (docs/classroom.md)")
     room.add_argument("--connect", metavar="URL",
                       help="connect to the classroom server at URL (ws://HOST:PORT): the station and the clock are "
@@ -106,15 +117,48 @@ def cmd_tui(args: argparse.Namespace) -> int:
             stored = instructor_hash(args.password_file)
         except PasswordError as exc:
             return refuse("tui", str(exc), Exit.USAGE)
+    field = _field(args, station)
+    if isinstance(field, int):
+        return field
     from liansuo.tui.app import ConsoleApp
 
     try:
         app = ConsoleApp(args.station, paused=args.paused, speed=args.speed, record=args.record,
-                         exercise=args.exercise, instructor_hash=stored, mute=args.mute)
+                         exercise=args.exercise, instructor_hash=stored, mute=args.mute,
+                         field=field[0] if field else None, changeover_hash=field[1] if field else None)
     except OSError as exc:
         return refuse("tui", str(exc), Exit.BAD_INPUT)
     app.run()
     return closed(app, "tui")
+
+
+def _field(args: argparse.Namespace, station: Station) -> tuple[FieldLink, str] | int | None:
+    """``--field``: the link and QHA's password hash; None without it; an exit status for a bad option."""
+    if args.field is None:
+        if args.points or args.changeover_password_file:
+            return refuse("tui", f"{'--points' if args.points else '--changeover-password-file'} goes with "
+                          "--field HOST:PORT", Exit.USAGE)
+        return None
+    from liansuo.classroom.passwords import CHANGEOVER_ENV, PasswordError, instructor_hash
+    from liansuo.fieldio.cli import address, points_for
+    from liansuo.fieldio.link import EXTRA, ModbusLink, available
+
+    if not available():
+        return refuse("tui", EXTRA, Exit.USAGE)
+    try:
+        host, port = address(args.field)
+    except argparse.ArgumentTypeError as exc:
+        return refuse("tui", f"--field: {exc}", Exit.USAGE)
+    try:
+        stored = instructor_hash(args.changeover_password_file, whose="change-over", env=CHANGEOVER_ENV,
+                                 option="--changeover-password-file")
+    except PasswordError as exc:
+        return refuse("tui", str(exc), Exit.USAGE)
+    try:
+        points = points_for(station, args.points)
+    except StationError as exc:
+        return bad_input(exc, "point map")
+    return ModbusLink(host, port, points), stored
 
 
 def _classroom_only(args: argparse.Namespace) -> str | None:
@@ -126,7 +170,8 @@ def _classroom_only(args: argparse.Namespace) -> str | None:
 def _connect(args: argparse.Namespace) -> int:
     """``--connect``: the station, the clock and the exercises are the server's, so their options are refused."""
     local = [o for o, v in (("STATION", args.station), ("--paused", args.paused), ("--speed", args.speed != 1.0),
-                            ("--record", args.record), ("--exercise", args.exercise)) if v not in (None, False)]
+                            ("--record", args.record), ("--exercise", args.exercise), ("--field", args.field))
+             if v not in (None, False)]
     if local:
         return refuse("tui", f"{local[0]} is not for --connect: the classroom server holds the station, its clock "
                       "and its exercises", Exit.USAGE)

@@ -187,9 +187,13 @@ class PasswordScreen(Dialog[str]):
     AUTO_FOCUS = "Input"
     BINDINGS: ClassVar[list[BindingType]] = [Binding("escape", "close", "close")]
 
+    def __init__(self, title: str = "教员 Instructor mode: password") -> None:
+        super().__init__()
+        self.title_text = title
+
     def compose(self) -> ComposeResult:
         with Vertical():
-            yield Label("教员 Instructor mode: password")
+            yield Label(self.title_text)
             yield Input(password=True, id="password")
 
     def on_input_submitted(self, event: Input.Submitted) -> None:
