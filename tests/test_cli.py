@@ -17,7 +17,8 @@ import pytest
 from liansuo.cli.main import build_parser
 
 SUBCOMMANDS = {"stations", "check", "schema", "generate", "table", "zpw", "25hz", "run", "test", "verify", "soak",
-               "explore", "mutate", "fuzz", "bench", "tui", "replay", "serve", "completion", "exercise"}
+               "explore", "mutate", "fuzz", "bench", "tui", "replay", "serve", "completion", "exercise", "field-sim",
+               "field-map"}
 
 
 def test_every_subcommand_is_registered() -> None:
