@@ -11,7 +11,6 @@ import socket
 import subprocess
 import sys
 import threading
-import time
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -19,69 +18,13 @@ import pytest
 
 pytest.importorskip("pymodbus", reason="the field extra (pymodbus) is not installed")
 
+from fieldsim import STATION, FieldSim, free_port
+
 from liansuo.fieldio import points
 from liansuo.fieldio.link import ModbusLink
 from liansuo.fieldio.server import FieldServer, serve
 from liansuo.fieldio.yard import FieldYard
 from liansuo.simulation.sim import Simulation
-
-STATION = "jiaopei"
-
-
-def free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return int(s.getsockname()[1])
-
-
-class FieldSim:
-    """``liansuo field-sim`` in its own process: its stdin takes the instructor's commands, its stdout is read
-    line by line in a thread."""
-
-    def __init__(self, port: int, *extra: str) -> None:
-        self.port = port
-        self.proc = subprocess.Popen([sys.executable, "-m", "liansuo", "field-sim", STATION, "--modbus",
-                                      f"127.0.0.1:{port}", *extra], stdin=subprocess.PIPE,
-                                     stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-        self.lines: list[str] = []
-        first = self.proc.stdout.readline() if self.proc.stdout else ""
-        assert first.startswith(f"field-sim {STATION}: modbus 127.0.0.1:{port}"), \
-            first + (self.proc.stderr.read() if self.proc.stderr else "")
-        threading.Thread(target=self._read, daemon=True).start()
-
-    def _read(self) -> None:
-        assert self.proc.stdout is not None
-        for line in self.proc.stdout:
-            self.lines.append(line.rstrip("\n"))
-
-    def send(self, line: str, answer: str = "", timeout: float = 10.0) -> str:
-        """Send an instructor's line; wait for a reply line containing ``answer``."""
-        assert self.proc.stdin is not None
-        seen = len(self.lines)
-        self.proc.stdin.write(line + "\n")
-        self.proc.stdin.flush()
-        return self.wait_for(answer, seen, timeout)
-
-    def wait_for(self, text: str, since: int = 0, timeout: float = 10.0) -> str:
-        end = time.monotonic() + timeout
-        while time.monotonic() < end:
-            for line in self.lines[since:]:
-                if text in line:
-                    return line
-            time.sleep(0.02)
-        raise AssertionError(f"no line with {text!r} from field-sim: {self.lines[-10:]}")
-
-    def kill(self) -> None:
-        self.proc.kill()
-        self.proc.wait()
-
-    def stop(self) -> None:
-        if self.proc.poll() is None:
-            self.proc.terminate()
-            try:
-                self.proc.wait(5)
-            except subprocess.TimeoutExpired:
-                self.kill()
 
 
 @pytest.fixture
@@ -375,3 +318,67 @@ def test_point_map_checked_against_the_station(tmp_path: Path) -> None:
                        capture_output=True, text=True, timeout=60)
     assert r.returncode == 3
     assert f"{bad}:{gj + 1}:" in r.stderr and "no section '1DGX'" in r.stderr and "Traceback" not in r.stderr
+
+
+def test_elements_left_out_of_the_map_stay_simulated() -> None:
+    """Per element, as the teaching base wires only part of its yard to the field: IG left out of the map stays on
+    the simulation panel (its occupancy switch works at the interlocking), 3G is the field's."""
+    port = free_port()
+    sim = Simulation(STATION)
+    whole = points.generate(sim.station, sim.rules)
+    part = whole.model_copy(update={"inputs": [p for p in whole.inputs if p.element != "IG"],
+                                    "outputs": [p for p in whole.outputs if p.element != "IG"],
+                                    "codes": [p for p in whole.codes if p.section != "IG"]})
+    pm = points.PointMap(part, points.elements_of(part))
+    assert "IG" not in pm.elements.tracks and "3G" in pm.elements.tracks
+    sim.attach_field(ModbusLink("127.0.0.1", port, pm))
+    server = FieldServer(FieldYard(sim.station, sim.rules), pm, log=lambda line: None)
+    ready, stop = threading.Event(), threading.Event()
+
+    async def run() -> None:
+        task = asyncio.create_task(serve(server, "127.0.0.1", port, ready=ready.set))
+        while not stop.is_set():
+            await asyncio.sleep(0.02)
+        task.cancel()
+
+    threading.Thread(target=lambda: asyncio.run(run()), daemon=True).start()
+    assert ready.wait(10)
+    try:
+        assert sim.command("changeover field")
+        assert sim.command("occupy IG")
+        sim.run(1)
+        assert sim.section_state("IG") == "occupied"
+        refused = sim.command("occupy 3G")
+        assert not refused and "section 3G is under field control" in refused.message
+        server.yard.command("occupy 3G")  # at the field
+        sim.run(1)
+        assert sim.section_state("3G") == "occupied"
+    finally:
+        stop.set()
+        sim.close()
+
+
+def test_tui_field_options_are_checked_before_a_console_starts(tmp_path: Path) -> None:
+    env = {k: v for k, v in os.environ.items() if k != "LIANSUO_CHANGEOVER_PASSWORD"}
+    cases = [(["--field", "127.0.0.1:1"], "no change-over password"),
+             (["--points", "x.yaml"], "goes with --field"),
+             (["--field", "nowhere"], "HOST:PORT")]
+    for extra, said in cases:
+        r = subprocess.run([sys.executable, "-m", "liansuo", "tui", STATION, *extra], capture_output=True, text=True,
+                           timeout=60, env=env, stdin=subprocess.DEVNULL)
+        assert r.returncode == 2 and said in r.stderr and "Traceback" not in r.stderr, (extra, r.stderr)
+
+
+def test_a_train_at_the_field_simulator_runs_through_a_route_the_interlocking_sees_by_relays(field: FieldSim) -> None:
+    """The interlocking needs nothing but relay states: a train placed at the field simulator runs in on X-XI, and
+    the route releases section by section behind it, as in simulated control."""
+    sim = interlocking(field.port)
+    assert sim.command("changeover field")
+    assert "placed" in field.send("train T1 at IAG mode=signal", "T1 placed")
+    assert sim.command("route X XI")
+    sim.run(60)
+    assert sim.route_state("X-XI") == "released"
+    assert sim.section_state("IG") == "occupied" and sim.section_state("1DG") == "free"
+    texts = sim.event_texts()
+    assert any("X-XI" in t and "released" in t for t in texts)
+    sim.close()
