@@ -67,9 +67,10 @@ def test_qha_asks_its_password_and_the_status_line_shows_the_mode(field: FieldSi
             assert app.sim.aspect("X") == "U"
             field.kill()
             app.advance(1)
+            app.refresh_views()
             await pilot.pause()
             assert "LINK LOST" in status(app) and app.sim.aspect("X") == "H"
-            assert any("field link lost" in line for line in app.log_panel.lines_text)
+            assert any("field link lost" in line for line in app.log_panel.lines_text), app.log_panel.lines_text[-12:]
 
     drive()
     lines = [json.loads(line) for line in record.read_text(encoding="utf-8").splitlines()]

@@ -273,13 +273,21 @@ def test_event_log_of_a_session_is_the_same_in_field_and_simulated_control(field
     in_field.close()
 
 
-def test_field_simulator_watchdog_de_energises_when_heartbeats_stop(field: FieldSim) -> None:
-    sim = interlocking(field.port)
-    _open_route(sim)
-    seen = len(field.lines)
-    sim.close()  # the interlocking goes away: no more heartbeats
-    line = field.wait_for("no heartbeat from the interlocking", seen, timeout=5)
-    assert "de-energised" in line
+def test_field_simulator_watchdog_de_energises_when_heartbeats_stop_and_the_interlocking_hears_of_it() -> None:
+    field = FieldSim(free_port(), "--watchdog", "0.3")
+    try:
+        sim = interlocking(field.port)
+        _open_route(sim)
+        seen = len(field.lines)  # the interlocking stops: no more heartbeats
+        line = field.wait_for("no heartbeat from the interlocking", seen, timeout=5)
+        assert "de-energised" in line
+        _fail_safe_in_one_cycle(sim, "watchdog de-energised its outputs")
+        sim.run(3)
+        assert any("field link restored" in e for e in sim.event_texts())
+        assert sim.aspect("X") == "H", "the outputs the field dropped do not come back by themselves"
+        sim.close()
+    finally:
+        field.stop()
 
 
 def test_field_simulator_refuses_the_signallers_commands(field: FieldSim) -> None:

@@ -4,7 +4,8 @@ One exchange per interlocking cycle: write every coil and code register, then th
 cycles, 1 to 65535 and round again, never 0), then read the echo register until the field echoes that count, and
 the discrete inputs it set after acting on the commands. Anything else is :class:`LinkLost`, naming what failed: no
 connection, no reply within ``timeout_s``, an exception reply, fewer bits than asked, an echo that does not come
-(stale inputs: the field no longer acts on what it is sent).
+(stale inputs: the field no longer acts on what it is sent), or an echo of 0 after others (the field's watchdog
+dropped its outputs).
 """
 
 from __future__ import annotations
@@ -43,6 +44,7 @@ class ModbusLink:
         self.unit = points.file.unit
         self.client = ModbusTcpClient(host, port=port, timeout=timeout_s, retries=0, reconnect_delay=0)
         self.beat = 0
+        self.echoed = False  # the field has echoed a heartbeat since the link was made
 
     @property
     def where(self) -> str:
@@ -106,10 +108,16 @@ class ModbusLink:
             rr = self.client.read_input_registers(at, count=1, device_id=self.unit)
             if rr.isError() or len(rr.registers) < 1:
                 raise LinkLost(f"{self.where}: a malformed reply to the read of the echo register {at}: {rr}")
-            if rr.registers[0] == self.beat:
+            echo = rr.registers[0]
+            if echo == self.beat:
+                self.echoed = True
                 return
+            if echo == 0 and self.echoed:
+                self.echoed = False
+                raise LinkLost(f"{self.where}: the field's watchdog de-energised its outputs (no heartbeat came in "
+                               "its time)")
             if time.monotonic() >= deadline:
-                raise LinkLost(f"{self.where}: stale inputs: the field echoes heartbeat {rr.registers[0]}, not "
+                raise LinkLost(f"{self.where}: stale inputs: the field echoes heartbeat {echo}, not "
                                f"{self.beat}, after {self.timeout_s:g} s")
             time.sleep(0.001)
 

@@ -6,8 +6,9 @@ register, the field simulator takes the coils and code registers as the commands
 read. pymodbus serves the protocol; the device's behaviour is its action hook (:meth:`FieldServer.action`).
 
 The watchdog: when no new heartbeat comes for ``watchdog_s``, every output is taken as de-energised (lamps dark,
-no turnout drive, no code, no door command), as an I/O module's communication watchdog does, until heartbeats come
-again with commands.
+no turnout drive, no code, no door command), as an I/O module's communication watchdog does. The first heartbeat
+after that is not acted on: the echo register answers 0, which the interlocking takes as a lost link (its signals
+close, and reopen only when the signaller reopens them); the heartbeats after it are acted on again.
 """
 
 from __future__ import annotations
@@ -40,9 +41,10 @@ class FieldServer:
         self.yard, self.pm, self.watchdog_s, self.log = yard, points, watchdog_s, log
         self.coils = [False] * points.coil_count
         self.registers: dict[int, int] = {}
-        self.beat = 0  # the heartbeat last acted on (the echo)
+        self.beat = 0  # the heartbeat last acted on (the echo); 0 after the watchdog tripped
         self.heard = time.monotonic()
-        self.tripped = True  # de-energised until the first heartbeat
+        self.energised = False  # a heartbeat has come
+        self.tripped = False  # the watchdog de-energised the outputs; the next heartbeat is answered with echo 0
         self.cycles = 0
         self._told: object = None  # the last of the yard's events logged
 
@@ -87,8 +89,14 @@ class FieldServer:
         if beat == self.beat or beat == 0:
             return
         self.heard = time.monotonic()
-        if self.tripped:
+        if self.tripped:  # tell the interlocking its outputs were dropped: echo 0, the link is lost to it
             self.tripped = False
+            self.beat = 0
+            self.log(f"{self.yard.t:9.2f} link     heartbeat {beat} after the watchdog: answered with echo 0 (a "
+                     "lost link to the interlocking)")
+            return
+        if not self.energised:
+            self.energised = True
             self.log(f"{self.yard.t:9.2f} link     heartbeat {beat}: outputs energised from the interlocking")
         self.yard.step_with(frames.commands(self.pm, self.coils, self.registers, self.yard.bus))
         self.beat = beat
@@ -97,9 +105,9 @@ class FieldServer:
 
     def watch(self) -> None:
         """De-energise every output when the heartbeat has stopped for ``watchdog_s``."""
-        if self.tripped or time.monotonic() - self.heard < self.watchdog_s:
+        if not self.energised or self.tripped or time.monotonic() - self.heard < self.watchdog_s:
             return
-        self.tripped = True
+        self.tripped, self.energised = True, False
         self.coils = [False] * len(self.coils)
         self.registers = {k: 0 for k in self.registers}
         dark = frames.commands(self.pm, self.coils, self.registers, self.yard.bus)
