@@ -184,10 +184,11 @@ def test_stale_inputs_fail_safe_in_one_cycle() -> None:
         sim.close()
 
 
-def test_garbage_replies_fail_safe_in_one_cycle(field: FieldSim) -> None:
+@pytest.mark.parametrize("reply", ["garbage", "silence"])
+def test_garbage_replies_and_no_reply_fail_safe_in_one_cycle(field: FieldSim, reply: str) -> None:
     sim = interlocking(field.port)
     _open_route(sim)
-    # the field's address now answers with noise: a server that replies garbage to whatever it is sent
+    # the field's address now answers with noise, or reads and never answers (a timeout)
     assert sim.control is not None
     port = free_port()
     stop = threading.Event()
@@ -213,7 +214,8 @@ def test_garbage_replies_fail_safe_in_one_cycle(field: FieldSim) -> None:
                         continue
                     except OSError:
                         break
-                    conn.sendall(os.urandom(3) + b"\x00\x07\xff\x01\x02garbage")
+                    if reply == "garbage":
+                        conn.sendall(os.urandom(3) + b"\x00\x07\xff\x01\x02garbage")
                 conn.close()
 
     threading.Thread(target=garbage, daemon=True).start()

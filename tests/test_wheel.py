@@ -370,7 +370,7 @@ from importlib.resources import files
 from pathlib import Path
 
 root = Path(str(files("liansuo")))
-for kind in ("station", "script", "scenario", "exercise"):
+for kind in ("station", "script", "scenario", "exercise", "points"):
     path = root / "schemas" / f"{kind}-1.json"
     print(kind, json.loads(path.read_text(encoding="utf-8"))["$id"], path)
 example = root / "examples" / "stations" / "minimal.yaml"
@@ -389,7 +389,7 @@ def test_version_completion_and_the_shipped_schemas(installed: Installed) -> Non
                installed.env)
     lines = dict(line.split(" ", 1) for line in out.splitlines())
     assert lines["modeline"] == "True", f"the example's modeline does not name the installed schema:\n{out}"
-    for kind in ("station", "script", "scenario", "exercise"):
+    for kind in ("station", "script", "scenario", "exercise", "points"):
         schema_id, path = lines[kind].split(" ", 1)
         assert schema_id == f"https://liansuo.dev/schema/{kind}-1.json", out
         assert Path(path).resolve().is_relative_to(installed.venv.resolve()), f"{kind} schema not installed: {path}"
@@ -408,3 +408,18 @@ def test_a_plot_without_the_plot_extra_says_how_to_get_it(installed: Installed) 
          [installed.liansuo, "zpw", "gaotie", "--section", "X2JG", "--plot-csv", "x2jg.csv"], installed.work,
          installed.env)
     assert (installed.work / "x2jg.csv").read_text(encoding="utf-8").startswith("section,case,position_m,")
+
+
+def test_field_mode_without_the_field_extra_says_how_to_get_it(installed: Installed) -> None:
+    """pymodbus is the field extra: field-sim and the console's --field stop with one line and exit status 2, while
+    field-map and check --points, which need nothing more, work from the installed package."""
+    proc = run([installed.liansuo, "field-sim", "jiaopei", "--modbus", "127.0.0.1:5020"], installed.work,
+               installed.env)
+    assert proc.returncode == 2, describe(proc, installed.work)
+    assert proc.stderr == "liansuo field-sim: field mode needs the field extra: pip install 'liansuo[field]' " \
+                          "(pymodbus)\n", proc.stderr
+    must("liansuo field-map jiaopei -o map.yaml", [installed.liansuo, "field-map", "jiaopei", "-o", "map.yaml"],
+         installed.work, installed.env)
+    out = must("liansuo check jiaopei --points map.yaml",
+               [installed.liansuo, "check", "jiaopei", "--points", "map.yaml"], installed.work, installed.env)
+    assert "field control of 16 sections, 7 turnouts, 11 signals" in out, out
