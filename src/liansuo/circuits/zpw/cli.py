@@ -28,6 +28,8 @@ VALIDATE = "validate"
 def cmd_zpw(args: argparse.Namespace) -> int:
     if args.station == VALIDATE:
         return cmd_validate(args)
+    if args.strict:
+        return refuse("zpw", "--strict goes with 'liansuo zpw validate'", Exit.USAGE)
     if args.output and (why := unwritable(Path(args.output))):
         return refuse("zpw", why, Exit.USAGE)
     if why := plot_problem(args):
@@ -61,25 +63,32 @@ def cmd_zpw(args: argparse.Namespace) -> int:
 
 
 def cmd_validate(args: argparse.Namespace) -> int:
-    """``liansuo zpw validate``: the article's rows beside the model's, always exit status 0 (a report, not a
-    check: docs/zpw2000a.md says why)."""
+    """``liansuo zpw validate``: the article's rows beside the model's; exit status 0 (a report), or with
+    ``--strict`` 1 when fewer rows than the target agree in magnitude."""
     given = [opt for opt, value in (("--fault", args.fault), ("--plot", args.plot), ("--plot-csv", args.plot_csv),
                                     ("--section", args.section)) if value]
     if given or args.format == "csv":
         what = given[0] if given else "--format csv"
-        return refuse("zpw", f"{what} does not go with 'validate', which takes only --format text|json and -o FILE",
-                      Exit.USAGE)
+        return refuse("zpw", f"{what} does not go with 'validate', which takes only --format text|json, -o FILE "
+                      "and --strict", Exit.USAGE)
     if args.output and (why := unwritable(Path(args.output))):
         return refuse("zpw", why, Exit.USAGE)
-    from liansuo.circuits.zpw.validate import as_text, summary, validate
+    from liansuo.circuits.zpw.validate import as_text, conclusions, summary, validate
 
     rows = validate()
+    total = summary(rows)
+    ok = total["target_met"] or not args.strict
     if args.format == "json":
-        text = json.dumps(report("zpw validate", True, {"rows": list(rows), "summary": summary(rows)}),
+        text = json.dumps(report("zpw validate", ok, {"rows": list(rows), "summary": total,
+                                                      "conclusions": conclusions()}),
                           ensure_ascii=False, indent=2) + "\n"
     else:
         text = as_text(rows) + "\n"
-    return deliver("zpw", text, args.output, [])
+    status = deliver("zpw", text, args.output, [])
+    if status == 0 and not ok:
+        return refuse("zpw", f"--strict: the size agrees on {total['magnitude_ok']} of {total['rows']} rows, under "
+                      f"the target of {total['target_share'] * 100:.0f} %", Exit.FAILED)
+    return status
 
 
 def _plot_cases(station: Station, args: argparse.Namespace) -> tuple[str, list[dict[int, str]]] | None:
@@ -122,5 +131,7 @@ def register(add: Callable[[str, Callable[[argparse.Namespace], int], str], argp
     sp.add_argument("--format", choices=("text", "json", "csv"), default="text", help="text (default), json or csv")
     sp.add_argument("-o", "--output", metavar="FILE", help="write to FILE instead of stdout")
     add_plot_options(sp, "the shunt residual and the cab-signal current along one section, healthy and faulted")
+    sp.add_argument("--strict", action="store_true", help="with 'validate': exit status 1 when fewer rows than the "
+                    "target (80 %%) agree with the article in magnitude")
     sp.add_argument("--section", metavar="ID", help="the section to plot (default: the one the faults name, else the "
                     "first ZPW-2000A section)")
