@@ -43,13 +43,13 @@ def test_the_bundled_rule_set_has_every_part() -> None:
 def test_one_name_chooses_every_part(folder: Path) -> None:
     edit(folder / "equipment.yaml", "open_s: 3.0", "open_s: 7.0")
     edit(folder / "driving.yaml", "stop_margin_m: 8", "stop_margin_m: 12")
-    edit(folder / "design.yaml", "bogie_wheelbase_min_m: 1.75", "bogie_wheelbase_min_m: 0.5")
+    edit(folder / "design.yaml", "joint_stagger_max_turnout_m: 5.0", "joint_stagger_max_turnout_m: 0.5")
     edit(folder / "interlocking.yaml", "guide_close_s: 60", "guide_close_s: 45")
     sim = Simulation("jiaopei", rules=str(folder))
     assert sim.rules.name == "mine" and sim.interlocking.rules is sim.rules and sim.rules.guide_close_s == 45
     assert all(d.spec.open_s == 7.0 for d in sim.field.doors.values())
     assert sim.fleet.rules.driving.stop_margin_m == 12
-    assert len(sim.station.warnings) > len(Simulation("jiaopei").station.warnings)  # dead zones hold a bogie now
+    assert len(sim.station.warnings) > len(Simulation("jiaopei").station.warnings)  # its 0.8-1.2 m staggers now warn
 
 
 def test_bad_rule_data_names_file_line_and_what_is_wrong(folder: Path) -> None:

@@ -343,9 +343,6 @@ class Warned:
 WARNED = [
     Warned("joint stagger too large", edit(BASE, ("at2: 200.5", "at2: 206")),
            ("joint 'J-X'", "staggered 6 m", f"limit {R.joint_stagger_max_turnout_m:g} m"), "206}"),
-    Warned("dead zone long enough to hold a bogie", edit(BASE, ("at2: 200.5", "at2: 202")),
-           ("joint 'J-X'", "2 m dead zone", "can hold a whole bogie", f"from {R.bogie_wheelbase_min_m:g} m"),
-           "202}"),
     Warned("dead zones too close",
            edit(BASE, ("{id: J-X, at: 200, at2: 200.5}", "{id: J-X, at: 240, at2: 241}"),
                 ("{id: J-13, at: 310}", "{id: J-13, at: 255, at2: 256}")),
@@ -390,8 +387,6 @@ WARNED = [
 @pytest.mark.parametrize("case", WARNED, ids=[w.name for w in WARNED])
 def test_design_rule_warning_states_figure_and_limit(case: Warned) -> None:
     warnings = warnings_of(case.text)
-    if case.name == "joint stagger too large":  # a stagger over the limit also holds a bogie: that warning too
-        warnings = [w for w in warnings if "can hold a whole bogie" not in w.message]
     assert len(warnings) == 1, "\n".join(str(w) for w in warnings)
     w = warnings[0]
     for fragment in case.fragments:
@@ -403,7 +398,7 @@ def test_design_rule_warning_states_figure_and_limit(case: Warned) -> None:
 
 def test_no_warning_within_the_limits() -> None:
     ok = [
-        edit(BASE, ("at2: 200.5", f"at2: {200 + R.bogie_wheelbase_min_m - 0.05:g}")),
+        edit(BASE, ("at2: 200.5", f"at2: {200 + R.joint_stagger_max_m:g}")),  # 2.5 m: within the rule
         edit(BASE, ("track: t-1b, at: 290}", f"track: t-LQ, at: {900 + R.fouling_clearance_m:g}}}")),
         edit(BASE, ("{id: IG, type: 25hz,", "{id: IG, type: zpw2000a, carrier: 1700-1, capacitors: {rule: standard},")),
         edit(BASE, ("{id: IAG, type: 25hz, role: approach}",

@@ -89,7 +89,6 @@ class DesignRules(Part):
     tuning_dead_zone_max_m: Metres
     capacitor_min_section_m: Metres
     phase25hz_max_length_m: Metres
-    bogie_wheelbase_min_m: Metres
 
     def turnout_speed_kmh(self, number: int) -> float:
         """The typical diverging speed of a turnout of this number (the figure of the largest number not above it)."""
