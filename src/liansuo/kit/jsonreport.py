@@ -18,6 +18,7 @@ from typing import Any, TextIO
 SCHEMAS: dict[str, int] = {
     "stations": 1, "check": 1, "table": 1, "zpw": 1, "test": 1, "run": 1, "verify": 1, "soak": 1, "explore": 1,
     "mutate": 1, "bench": 1, "replay": 1, "25hz": 1, "zpw validate": 1, "fuzz": 1, "exercise": 1,
+    "zpw sweep": 1,
 }
 
 

@@ -2,7 +2,8 @@
 [--plot FILE] [--plot-csv FILE] [--section ID]``: the command line of :mod:`.figures` (the table) and
 :mod:`.plot` (the profiles along one section). ``liansuo zpw validate [--format text|json] [-o FILE]`` (the
 reserved word ``validate`` in place of STATION; a station file of that name is ``./validate``) puts the model beside
-the capacitor-fault article (:mod:`.validate`)."""
+the capacitor-fault article (:mod:`.validate`); ``liansuo zpw sweep`` (another reserved word) runs a parameter study
+of one section (:mod:`.study`)."""
 
 from __future__ import annotations
 
@@ -23,9 +24,19 @@ from liansuo.stations.loader import load
 from liansuo.stations.station import Station
 
 VALIDATE = "validate"
+SWEEP = "sweep"
+# the options only 'liansuo zpw sweep' takes, with their defaults (to tell them given)
+SWEEP_OPTIONS: dict[str, object] = {"length": None, "layout": None, "carrier": [], "ballast": [], "capacitance": None,
+                                    "faults": None, "samples": None, "ballast_tolerance": None,
+                                    "capacitor_tolerance": None, "seed": None}
 
 
 def cmd_zpw(args: argparse.Namespace) -> int:
+    if args.station == SWEEP:
+        return cmd_sweep(args)
+    given = [f"--{k.replace('_', '-')}" for k, default in SWEEP_OPTIONS.items() if getattr(args, k) != default]
+    if given:
+        return refuse("zpw", f"{given[0]} goes with 'liansuo zpw sweep'", Exit.USAGE)
     if args.station == VALIDATE:
         return cmd_validate(args)
     if args.strict:
@@ -121,11 +132,62 @@ def check_warnings(station: Station) -> list[Diagnostic]:
     return station_warnings(station)
 
 
+def cmd_sweep(args: argparse.Namespace) -> int:
+    """``liansuo zpw sweep``: a study of one section (:mod:`.study`), its summary as text, or every row as CSV or
+    JSON."""
+    from liansuo.circuits.zpw.params import carrier_frequency_Hz
+    from liansuo.circuits.zpw.study import COLUMNS, Study, csv_rows, run_study, summary_text
+
+    given = [opt for opt, value in (("--fault", args.fault), ("--plot", args.plot), ("--plot-csv", args.plot_csv),
+                                    ("--section", args.section), ("--strict", args.strict)) if value]
+    if given:
+        return refuse("zpw", f"{given[0]} does not go with 'sweep' (its options: docs/zpw2000a.md, 'Sweeps')",
+                      Exit.USAGE)
+    if args.output and (why := unwritable(Path(args.output))):
+        return refuse("zpw", why, Exit.USAGE)
+    for carrier in args.carrier:
+        try:
+            carrier_frequency_Hz(carrier)
+        except (KeyError, ValueError):
+            return refuse("zpw", f"--carrier {carrier}: give a ZPW-2000A carrier (1700, 2000-1, 2600-2 ...)",
+                          Exit.USAGE)
+    study = Study(length_m=1400.0 if args.length is None else args.length, layout=args.layout or "conventional",
+                  carriers=tuple(args.carrier) or Study.carriers, ballasts=tuple(args.ballast) or None,
+                  capacitance_uF=args.capacitance, faults=args.faults or "none", samples=args.samples or 0,
+                  ballast_tolerance=0.2 if args.ballast_tolerance is None else args.ballast_tolerance,
+                  capacitor_tolerance=0.1 if args.capacitor_tolerance is None else args.capacitor_tolerance,
+                  seed=1 if args.seed is None else args.seed)
+    if why := study.problem():
+        return refuse("zpw", why, Exit.USAGE)
+    if study.length_m < 1.0 or study.length_m > 5000.0:
+        return refuse("zpw", f"--length {study.length_m:g}: give 1 to 5000 metres", Exit.USAGE)
+    if study.samples > 1_000_000:
+        return refuse("zpw", f"--samples {study.samples}: at most 1000000", Exit.USAGE)
+    try:
+        rows, summary = run_study(study)
+    except ValueError as exc:
+        return refuse("zpw", str(exc), Exit.USAGE)
+    if args.format == "csv":
+        buf = io.StringIO()
+        import csv
+
+        w = csv.writer(buf, lineterminator="\n")
+        w.writerow(COLUMNS)
+        w.writerows(csv_rows(rows))
+        text = buf.getvalue()
+    elif args.format == "json":
+        text = json.dumps(report("zpw sweep", True, {"summary": summary, "rows": rows}), ensure_ascii=False,
+                          indent=2) + "\n"
+    else:
+        text = summary_text(summary) + "\n"
+    return deliver("zpw", text, args.output, [])
+
+
 def register(add: Callable[[str, Callable[[argparse.Namespace], int], str], argparse.ArgumentParser]) -> None:
     """Add the ``zpw`` subcommand through the CLI's ``add(name, handler, help)``."""
     sp = add("zpw", cmd_zpw, "ZPW-2000A section figures: adjustment, shunt residual, cab current (with faults)")
     sp.add_argument("station", help="bundled station name or path; 'validate': the model against the capacitor-fault "
-                    "article (--format text|json, -o FILE)")
+                    "article (--format text|json, -o FILE, --strict); 'sweep': a parameter study of one section")
     sp.add_argument("--fault", action="append", default=[], metavar=FAULT_FORM,
                     help="a compensation-capacitor fault (repeatable); capacitors are numbered from the lower end")
     sp.add_argument("--format", choices=("text", "json", "csv"), default="text", help="text (default), json or csv")
@@ -133,5 +195,22 @@ def register(add: Callable[[str, Callable[[argparse.Namespace], int], str], argp
     add_plot_options(sp, "the shunt residual and the cab-signal current along one section, healthy and faulted")
     sp.add_argument("--strict", action="store_true", help="with 'validate': exit status 1 when fewer rows than the "
                     "target (80 %%) agree with the article in magnitude")
+    study = sp.add_argument_group("sweep", "liansuo zpw sweep: one section over carriers, ballasts, capacitor faults "
+                                           "or a Monte Carlo of tolerances (docs/zpw2000a.md, 'Sweeps')")
+    study.add_argument("--length", type=float, metavar="M", help="the section's length (default 1400 m)")
+    study.add_argument("--layout", choices=("conventional", "passenger-line", "passenger-station"),
+                       help="whose standard capacitors and design ballast (default conventional)")
+    study.add_argument("--carrier", action="append", default=[], metavar="HZ",
+                       help="a carrier, repeatable (default 1700-1, 2000-1, 2300-1, 2600-1)")
+    study.add_argument("--ballast", action="append", default=[], type=float, metavar="OHM_KM",
+                       help="a ballast resistance, repeatable (default the layout's design minimum)")
+    study.add_argument("--capacitance", type=float, metavar="UF", help="every capacitor's value (default the layout's)")
+    study.add_argument("--faults", choices=("none", "single-open", "single-half", "single"),
+                       help="the capacitor fault cases: none (default), every single one open, at -50 %%, or both")
+    study.add_argument("--samples", type=int, metavar="N", help="a Monte Carlo of about N healthy sections a carrier")
+    study.add_argument("--ballast-tolerance", type=float, metavar="F", help="Monte Carlo: ballast within +-F (0.2)")
+    study.add_argument("--capacitor-tolerance", type=float, metavar="F",
+                       help="Monte Carlo: each capacitor within +-F of its value (0.1)")
+    study.add_argument("--seed", type=int, metavar="N", help="Monte Carlo: the random seed (1)")
     sp.add_argument("--section", metavar="ID", help="the section to plot (default: the one the faults name, else the "
                     "first ZPW-2000A section)")

@@ -14,10 +14,13 @@ from liansuo.circuits.zpw import ends as zpwends
 from liansuo.circuits.zpw.model import FAULT_MODES, CArray, FArray, profile_points, solve, standard_positions
 from liansuo.circuits.zpw.params import CARRIERS, DEFAULT_PARAMS, ZpwParams
 
+Case = Mapping[int, str | float]  # 1-based capacitor number -> open / half / short, or a factor of its capacitance
 
-def _capacitor_table(carriers: Sequence[str], faults: Sequence[Mapping[int, str]], n: int, params: ZpwParams,
+
+def _capacitor_table(carriers: Sequence[str], faults: Sequence[Case], n: int, params: ZpwParams,
                      capacitance_uF: float | None = None) -> CArray:
-    """(C, F, N) admittances: each fault case maps 1-based capacitor numbers to open / half / short."""
+    """(C, F, N) admittances: each fault case maps 1-based capacitor numbers to open / half / short, or to a factor
+    of the capacitance (a tolerance: 0.9 is -10 %)."""
     ok = np.array([params.capacitor_admittance(c, "ok", capacitance_uF) for c in carriers])
     factor = np.ones((len(faults), n))
     short = np.zeros((len(faults), n), dtype=bool)
@@ -25,6 +28,11 @@ def _capacitor_table(carriers: Sequence[str], faults: Sequence[Mapping[int, str]
         for number, mode in case.items():
             if not 1 <= number <= n:
                 raise ValueError(f"capacitor {number} does not exist: the section has {n}")
+            if isinstance(mode, float):
+                if not 0.0 <= mode < 10.0:
+                    raise ValueError(f"capacitor {number}: a factor of its capacitance from 0 to 10, not {mode}")
+                factor[f, number - 1] = mode
+                continue
             if mode not in FAULT_MODES:
                 raise ValueError(f"unknown capacitor fault '{mode}': use open, half or short")
             factor[f, number - 1] = {"open": 0.0, "half": 0.5, "short": 1.0}[mode]
@@ -39,8 +47,10 @@ def single_faults(n: int, modes: Sequence[str] = FAULT_MODES) -> list[dict[int, 
     return [{}] + [{k: m} for m in modes for k in range(1, n + 1)]
 
 
-def fault_label(case: Mapping[int, str]) -> str:
-    return ", ".join(f"C{k} {m}" for k, m in sorted(case.items())) or "none"
+def fault_label(case: Case) -> str:
+    """'C3 open, C5 half', or 'none'; a capacitance factor as a percentage ('C3 -8.2 %')."""
+    return ", ".join(f"C{k} {m}" if isinstance(m, str) else f"C{k} {(m - 1) * 100:+.1f} %"
+                     for k, m in sorted(case.items())) or "none"
 
 
 @dataclass(frozen=True)
@@ -51,7 +61,7 @@ class SweepResult:
     capacitors_m: tuple[float, ...]
     carriers: tuple[str, ...]
     ballasts_ohm_km: tuple[float, ...]
-    faults: tuple[Mapping[int, str], ...]
+    faults: tuple[Case, ...]
     positions_m: FArray
     adjustment_mV: FArray  # (C, B, F)
     residual_mV: FArray  # (C, B, F, P)
@@ -73,7 +83,7 @@ class SweepResult:
 
 
 def sweep_section(length_m: float, capacitors_m: Sequence[float], carriers: Sequence[str] = CARRIERS,
-                  ballasts: Sequence[float] = (1.0,), faults: Sequence[Mapping[int, str]] | None = None,
+                  ballasts: Sequence[float] = (1.0,), faults: Sequence[Case] | None = None,
                   positions_m: Sequence[float] | None = None, params: ZpwParams = DEFAULT_PARAMS,
                   capacitance_uF: float | None = None) -> SweepResult:
     """Every configuration of one section at once; receiver gain set per carrier as ``ZpwCircuit`` sets it."""
