@@ -39,8 +39,9 @@ def cmd_zpw(args: argparse.Namespace) -> int:
         return refuse("zpw", f"{given[0]} goes with 'liansuo zpw sweep'", Exit.USAGE)
     if args.station == VALIDATE:
         return cmd_validate(args)
-    if args.strict:
-        return refuse("zpw", "--strict goes with 'liansuo zpw validate'", Exit.USAGE)
+    if args.strict or args.sensitivity:
+        word = "--strict" if args.strict else "--sensitivity"
+        return refuse("zpw", f"{word} goes with 'liansuo zpw validate'", Exit.USAGE)
     if args.output and (why := unwritable(Path(args.output))):
         return refuse("zpw", why, Exit.USAGE)
     if why := plot_problem(args):
@@ -80,21 +81,22 @@ def cmd_validate(args: argparse.Namespace) -> int:
                                     ("--section", args.section)) if value]
     if given or args.format == "csv":
         what = given[0] if given else "--format csv"
-        return refuse("zpw", f"{what} does not go with 'validate', which takes only --format text|json, -o FILE "
-                      "and --strict", Exit.USAGE)
+        return refuse("zpw", f"{what} does not go with 'validate', which takes only --format text|json, -o FILE, "
+                      "--strict and --sensitivity", Exit.USAGE)
     if args.output and (why := unwritable(Path(args.output))):
         return refuse("zpw", why, Exit.USAGE)
-    from liansuo.circuits.zpw.validate import as_text, conclusions, summary, validate
+    from liansuo.circuits.zpw.validate import as_text, conclusions, sensitivity, sensitivity_text, summary, validate
 
     rows = validate()
     total = summary(rows)
     ok = total["target_met"] or not args.strict
+    found = sensitivity() if args.sensitivity else None
     if args.format == "json":
-        text = json.dumps(report("zpw validate", ok, {"rows": list(rows), "summary": total,
-                                                      "conclusions": conclusions()}),
+        body = {"rows": list(rows), "summary": total, "conclusions": conclusions()}
+        text = json.dumps(report("zpw validate", ok, body | ({"sensitivity": found} if found else {})),
                           ensure_ascii=False, indent=2) + "\n"
     else:
-        text = as_text(rows) + "\n"
+        text = as_text(rows) + "\n" + (sensitivity_text(found) + "\n" if found else "")
     status = deliver("zpw", text, args.output, [])
     if status == 0 and not ok:
         return refuse("zpw", f"--strict: the size agrees on {total['magnitude_ok']} of {total['rows']} rows, under "
@@ -139,7 +141,8 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     from liansuo.circuits.zpw.study import COLUMNS, Study, csv_rows, run_study, summary_text
 
     given = [opt for opt, value in (("--fault", args.fault), ("--plot", args.plot), ("--plot-csv", args.plot_csv),
-                                    ("--section", args.section), ("--strict", args.strict)) if value]
+                                    ("--section", args.section), ("--strict", args.strict),
+                                    ("--sensitivity", args.sensitivity)) if value]
     if given:
         return refuse("zpw", f"{given[0]} does not go with 'sweep' (its options: docs/zpw2000a.md, 'Sweeps')",
                       Exit.USAGE)
@@ -195,6 +198,8 @@ def register(add: Callable[[str, Callable[[argparse.Namespace], int], str], argp
     add_plot_options(sp, "the shunt residual and the cab-signal current along one section, healthy and faulted")
     sp.add_argument("--strict", action="store_true", help="with 'validate': exit status 1 when fewer rows than the "
                     "target (80 %%) agree with the article in magnitude")
+    sp.add_argument("--sensitivity", action="store_true", help="with 'validate': also how the score moves with each "
+                    "parameter the article does not publish")
     study = sp.add_argument_group("sweep", "liansuo zpw sweep: one section over carriers, ballasts, capacitor faults "
                                            "or a Monte Carlo of tolerances (docs/zpw2000a.md, 'Sweeps')")
     study.add_argument("--length", type=float, metavar="M", help="the section's length (default 1400 m)")

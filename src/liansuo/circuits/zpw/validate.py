@@ -23,6 +23,7 @@ from typing import Any
 
 import yaml
 
+from liansuo.circuits.zpw.params import DEFAULT_PARAMS, ZpwParams
 from liansuo.kit.fit import fit_all
 
 DATA_FILE = Path(__file__).with_name("validate.yaml")
@@ -131,7 +132,11 @@ def _ratio(paper: float | None, model: float | None) -> float | None:
     return round(model / paper, 2)
 
 
-def _changes(section: ArticleSection, carriers: Sequence[str], ballast: float) -> dict[str, dict[str, list[float]]]:
+Absolute = dict[str, list[tuple[str, float, float, list[float], list[float]]]]
+
+
+def _changes(section: ArticleSection, carriers: Sequence[str], ballast: float, base: ZpwParams, ballast_scale: float,
+             absolute: Absolute) -> dict[str, dict[str, list[float]]]:
     """Percent change against the healthy section, per fault mode and computed quantity, over every carrier and
     every single faulted capacitor. A conventional section is swept at ``ballast``; a passenger-dedicated one at its
     own design minimum, with its layout's capacitors (which differ by carrier)."""
@@ -144,10 +149,10 @@ def _changes(section: ArticleSection, carriers: Sequence[str], ballast: float) -
     modes = ("open", "half")
     per_carrier: list[dict[str, Any]] = []
     for carrier in carriers:
-        params = layout_params(section.layout, carrier)
+        params = layout_params(section.layout, carrier, base)
         if section.ends == "insulated":
             params = dataclasses.replace(params, tuning_units=False)
-        at = ballast if section.layout == "conventional" else params.ballast_ohm_km
+        at = (ballast if section.layout == "conventional" else params.ballast_ohm_km) * ballast_scale
         caps = standard_positions(section.length_m, None, params)
         n = len(caps)
         cases: list[Mapping[int, str]] = [{}] + [{k: m} for m in modes for k in range(1, n + 1)]
@@ -155,7 +160,7 @@ def _changes(section: ArticleSection, carriers: Sequence[str], ballast: float) -
         figures = {"adjustment_voltage": result.adjustment_mV[0, 0, :],
                    "min_cab_current": result.min_cab_current_mA[0, 0, :],
                    "max_shunt_residual": result.max_shunt_residual_mV[0, 0, :]}
-        _ABSOLUTE.setdefault(section.id, []).append(
+        absolute.setdefault(section.id, []).append(
             (carrier, params.cab_min_mA[base_index(carrier)], params.drop_mV,
              [float(x) for x in result.min_cab_current_mA[0, 0, 1:]],
              [float(x) for x in result.max_shunt_residual_mV[0, 0, 1:]]))
@@ -181,17 +186,14 @@ def _range(changes: Sequence[float]) -> tuple[float, float]:
     return round(rise, 1) + 0.0, round(fall, 1) + 0.0
 
 
-# per section: (carrier, its cab-current minimum mA, the receiver's drop mV, min cab current per faulted case,
-# max shunt residual per faulted case), filled by _changes (both fault modes, one capacitor at a time)
-_ABSOLUTE: dict[str, list[tuple[str, float, float, list[float], list[float]]]] = {}
-
-
 @cache
-def validate(path: Path = DATA_FILE) -> tuple[dict[str, Any], ...]:
-    """Every row of the article's tables beside the model's figures, in the JSON report's shape."""
+def _run(path: Path, base: ZpwParams, ballast_scale: float) -> tuple[tuple[dict[str, Any], ...], Absolute]:
+    """The rows, and per section (carrier, its cab-current minimum mA, the receiver's drop mV, min cab current per
+    faulted case, max shunt residual per faulted case) for :func:`conclusions`."""
     article = read_article(path)
-    _ABSOLUTE.clear()
-    changes = {s.id: _changes(s, article.carriers, article.ballast_ohm_km) for s in article.sections}
+    absolute: Absolute = {}
+    changes = {s.id: _changes(s, article.carriers, article.ballast_ohm_km, base, ballast_scale, absolute)
+               for s in article.sections}
     rows = []
     for r in article.rows:
         found = changes[r.section][r.fault].get(r.quantity)
@@ -202,7 +204,14 @@ def validate(path: Path = DATA_FILE) -> tuple[dict[str, Any], ...]:
                      "rise_ratio": _ratio(r.rise_pct, rise), "fall_ratio": _ratio(r.fall_pct, fall),
                      "magnitude_ok": magnitude_ok(r.rise_pct, r.fall_pct, rise, fall),
                      "trend_ok": trend_ok(r.rise_pct, r.fall_pct, rise, fall)})
-    return tuple(rows)
+    return tuple(rows), absolute
+
+
+def validate(path: Path = DATA_FILE, base: ZpwParams = DEFAULT_PARAMS, ballast_scale: float = 1.0
+             ) -> tuple[dict[str, Any], ...]:
+    """Every row of the article's tables beside the model's figures, in the JSON report's shape; ``base`` and
+    ``ballast_scale`` change the unpublished parameters (:func:`sensitivity`)."""
+    return _run(path, base, ballast_scale)[0]
 
 
 def _share(n: int, of: int) -> float:
@@ -228,13 +237,13 @@ def summary(rows: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
             "min_cab_current_rows": len(cab_rows), "null_models": nulls}
 
 
-def conclusions(path: Path = DATA_FILE) -> list[dict[str, Any]]:
+def conclusions(path: Path = DATA_FILE, base: ZpwParams = DEFAULT_PARAMS, ballast_scale: float = 1.0
+                ) -> list[dict[str, Any]]:
     """The article's absolute findings against the model's faulted cases (every carrier, every single capacitor
     open or at -50 %): the shunt residual stays under the receiver's 153 mV drop everywhere, and the cab current
     stays above its minimum everywhere but in the station section with frequency selection."""
-    validate(path)
     out = []
-    for section, per_carrier in _ABSOLUTE.items():
+    for section, per_carrier in _run(path, base, ballast_scale)[1].items():
         cases = sum(len(c[3]) for c in per_carrier)
         under = sum(1 for _, least, _, cab, _ in per_carrier for v in cab if v < least)
         worst_residual = max(max(res) for *_, res in per_carrier)
@@ -291,4 +300,56 @@ def as_text(rows: Sequence[Mapping[str, Any]], path: Path = DATA_FILE) -> str:
                      f"{c['article_cab_under_minimum']:<4}) {'holds' if c['cab_holds'] else 'CONTRADICTED':<12} "
                      f"{c['max_residual_mV']:.0f} mV < {c['drop_mV']:.0f} mV "
                      f"{'holds' if c['residual_holds'] else 'CONTRADICTED'}")
+    return fit_all(lines)
+
+
+# The parameters the article does not publish, each at a low and a high value around the model's (docs/zpw2000a.md,
+# "Sensitivity"): (name, the change as text, the parameters, the ballast scale)
+def _variants() -> list[tuple[str, str, ZpwParams, float]]:
+    p = DEFAULT_PARAMS
+    out: list[tuple[str, str, ZpwParams, float]] = []
+    for name, field, values in (("cable length", "cable_km", (0.0, 5.0, 15.0)),
+                                ("coil and tuning-unit quality", "tuning_q", (10.0, 100.0)),
+                                ("air-core coil", "air_core_uH", (p.air_core_uH * 0.8, p.air_core_uH * 1.2)),
+                                ("L2 of the 2300/2600 Hz units", "f2_inductance_uH", (50.0, 200.0)),
+                                ("transmitter impedance", "source_ohm", (complex(2.0), complex(50.0))),
+                                ("receiver impedance", "receiver_ohm", (complex(400.0), complex(1600.0)))):
+        for v in values:
+            shown = f"{v.real:g}" if isinstance(v, complex) else f"{v:g}"
+            changed: Any = {field: v}  # one field of several types: checked by the dataclass itself
+            out.append((name, f"{field} = {shown}", dataclasses.replace(p, **changed), 1.0))
+    for scale in (0.9, 1.1):
+        c1, c2, c3, c4 = (c * scale for c in p.capacitance_uF)
+        cap = (c1, c2, c3, c4)
+        out.append(("capacitance", f"capacitance x {scale:g}", dataclasses.replace(p, capacitance_uF=cap), 1.0))
+    for scale in (1.5, 3.0):
+        out.append(("ballast", f"ballast x {scale:g}", p, scale))
+    return out
+
+
+def sensitivity(path: Path = DATA_FILE) -> list[dict[str, Any]]:
+    """How the score and the figures that differ most move with each unpublished parameter: per variant, the rows
+    that agree in size and in trend, the largest rise of the minimum cab current on the open lines (the article:
+    83-112 %), and the faulted cases on the conventional line under the cab-current minimum (the article: none)."""
+    out = []
+    for name, change, base, scale in [("the model", "as it stands", DEFAULT_PARAMS, 1.0), *_variants()]:
+        rows = validate(path, base, scale)
+        total = summary(rows)
+        cab_rise = max(r["model_rise_pct"] or 0.0 for r in rows
+                       if r["quantity"] == "min_cab_current" and r["section"].endswith("-line"))
+        line = next(c for c in conclusions(path, base, scale) if c["section"] == "conventional-line")
+        out.append({"parameter": name, "change": change, "magnitude_ok": total["magnitude_ok"],
+                    "trend_ok": total["trend_ok"], "open_line_cab_rise_pct": cab_rise,
+                    "conventional_cab_under_minimum": line["cab_under_minimum"],
+                    "conventional_faulted_cases": line["faulted_cases"]})
+    return out
+
+
+def sensitivity_text(found: Sequence[Mapping[str, Any]]) -> str:
+    lines = ["sensitivity to the parameters the article does not publish (docs/zpw2000a.md):",
+             f"{'parameter':<30} {'change':<26} {'size':>4} {'trend':>5} {'cab rise %':>10} {'cab < min':>10}"]
+    for f in found:
+        lines.append(f"{f['parameter']:<30} {f['change']:<26} {f['magnitude_ok']:>4} {f['trend_ok']:>5} "
+                     f"{f['open_line_cab_rise_pct']:>10.1f} {f['conventional_cab_under_minimum']:>4} of "
+                     f"{f['conventional_faulted_cases']}")
     return fit_all(lines)
