@@ -72,3 +72,20 @@ def test_refusals(capsys: pytest.CaptureFixture[str]) -> None:
         assert code == 2 and out == "" and said in err, (argv, err)
     assert main(["zpw", "jiaopei", "--samples", "3"]) == 2
     assert "--samples goes with 'liansuo zpw sweep'" in capsys.readouterr().err
+
+
+def test_profiles_along_the_section_as_csv_and_a_plot(tmp_path, capsys: pytest.CaptureFixture[str]) -> None:
+    """--plot-csv: the healthy section and the worst fault cases of the first carrier, point by point; --plot draws
+    them (with matplotlib, the plot extra)."""
+    target = tmp_path / "profiles.csv"
+    code, out, err = run(capsys, "--faults", "single-open", "--carrier", "2600-1", "--plot-csv", str(target))
+    assert code == 0 and err == "" and f"wrote {target}" in out
+    rows = list(csv.DictReader(target.open(encoding="utf-8")))
+    cases = list(dict.fromkeys(r["case"] for r in rows))
+    assert cases[0] == "healthy" and 2 <= len(cases) <= 7 and all(c.endswith(" open") for c in cases[1:])
+    healthy = [r for r in rows if r["case"] == "healthy"]
+    assert len(healthy) == 141 and float(healthy[0]["position_m"]) == 0.0  # every 10 m over 1400 m
+    pytest.importorskip("matplotlib")
+    png = tmp_path / "profiles.png"
+    code, out, err = run(capsys, "--samples", "100", "--plot", str(png))
+    assert code == 0 and png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

@@ -137,16 +137,18 @@ def check_warnings(station: Station) -> list[Diagnostic]:
 def cmd_sweep(args: argparse.Namespace) -> int:
     """``liansuo zpw sweep``: a study of one section (:mod:`.study`), its summary as text, or every row as CSV or
     JSON."""
+    from liansuo.circuits.zpw import study as studies
     from liansuo.circuits.zpw.params import carrier_frequency_Hz
     from liansuo.circuits.zpw.study import COLUMNS, Study, csv_rows, run_study, summary_text
 
-    given = [opt for opt, value in (("--fault", args.fault), ("--plot", args.plot), ("--plot-csv", args.plot_csv),
-                                    ("--section", args.section), ("--strict", args.strict),
+    given = [opt for opt, value in (("--fault", args.fault), ("--section", args.section), ("--strict", args.strict),
                                     ("--sensitivity", args.sensitivity)) if value]
     if given:
         return refuse("zpw", f"{given[0]} does not go with 'sweep' (its options: docs/zpw2000a.md, 'Sweeps')",
                       Exit.USAGE)
     if args.output and (why := unwritable(Path(args.output))):
+        return refuse("zpw", why, Exit.USAGE)
+    if why := plot_problem(args):
         return refuse("zpw", why, Exit.USAGE)
     for carrier in args.carrier:
         try:
@@ -183,7 +185,15 @@ def cmd_sweep(args: argparse.Namespace) -> int:
                           indent=2) + "\n"
     else:
         text = summary_text(summary) + "\n"
-    return deliver("zpw", text, args.output, [])
+    if args.plot or args.plot_csv:
+        carrier, ballast, profs = studies.profiles(study)
+        if args.plot_csv and (why := write_rows(args.plot_csv, studies.PROFILE_COLUMNS,
+                                                studies.profile_rows(carrier, ballast, profs))):
+            return refuse("zpw", why, Exit.USAGE)
+        if args.plot and (why := studies.draw(study, carrier, ballast, profs, args.plot)):
+            return refuse("zpw", why, Exit.USAGE)
+    also = [f for f in (args.plot, args.plot_csv) if f] if args.format == "text" else []
+    return deliver("zpw", text, args.output, also)
 
 
 def register(add: Callable[[str, Callable[[argparse.Namespace], int], str], argparse.ArgumentParser]) -> None:

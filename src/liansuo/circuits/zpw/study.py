@@ -153,3 +153,87 @@ def summary_text(summary: Mapping[str, Any]) -> str:
 
 def csv_rows(rows: Sequence[Mapping[str, Any]]) -> list[list[Any]]:
     return [[r[c] for c in COLUMNS] for r in rows]
+
+
+# ---- the profiles along the section (--plot, --plot-csv) -----------------------------------------------------------
+PROFILE_COLUMNS = ("carrier", "ballast_ohm_km", "case", "position_m", "shunt_residual_mV", "cab_current_mA",
+                   "adjustment_mV")
+WORST_FEW = 3
+
+
+def profiles(study: Study) -> tuple[str, float, list[dict[str, Any]]]:
+    """The study's first carrier and ballast along the section, the standard shunt at each point: the healthy
+    section, then the fault cases that raise the residual most and lower the cab current most (a few of each), or
+    for a Monte Carlo the 5th and 95th percentile at each point. Returns (carrier, ballast, profiles), each profile
+    ``{case, adjustment_mV, positions_m, residual_mV, cab_mA}``."""
+    rng = np.random.default_rng(study.seed)
+    carrier = study.carriers[0]
+    params = layout_params(study.layout, carrier)
+    caps = standard_positions(study.length_m, None, params)
+    cases = _cases(study, len(caps), rng)
+    ballast = _ballasts(study, params.ballast_ohm_km, rng)[0] if study.samples else \
+        (study.ballasts or (params.ballast_ohm_km,))[0]
+    if study.samples:
+        cases = [{}, *cases]
+    r = sweep_section(study.length_m, caps, [carrier], [ballast], cases, params=params,
+                      capacitance_uF=study.capacitance_uF)
+    residual, cab, adjust = r.residual_mV[0, 0], r.cab_current_mA[0, 0], r.adjustment_mV[0, 0]
+    pos = [float(x) for x in r.positions_m]
+
+    def one(case: str, f: int) -> dict[str, Any]:
+        return {"case": case, "adjustment_mV": float(adjust[f]), "positions_m": pos,
+                "residual_mV": [float(v) for v in residual[f]], "cab_mA": [float(v) for v in cab[f]]}
+
+    out = [one("healthy", 0)]
+    if study.samples:
+        for q in (5, 95):
+            out.append({"case": f"p{q} of {len(cases) - 1} samples",
+                        "adjustment_mV": float(np.percentile(adjust[1:], q)),
+                        "positions_m": pos, "residual_mV": [float(v) for v in np.percentile(residual[1:], q, axis=0)],
+                        "cab_mA": [float(v) for v in np.percentile(cab[1:], q, axis=0)]})
+    elif len(cases) > 1:
+        by_residual = sorted(range(1, len(cases)), key=lambda f: -float(residual[f].max()))[:WORST_FEW]
+        by_cab = sorted(range(1, len(cases)), key=lambda f: float(cab[f].min()))[:WORST_FEW]
+        for f in dict.fromkeys([*by_residual, *by_cab]):
+            out.append(one(_label(cases[f]), f))
+    return carrier, ballast, out
+
+
+def profile_rows(carrier: str, ballast: float, profs: Sequence[Mapping[str, Any]]) -> list[dict[str, Any]]:
+    return [{"carrier": carrier, "ballast_ohm_km": round(ballast, 4), "case": p["case"], "position_m": round(x, 2),
+             "shunt_residual_mV": round(v, 3), "cab_current_mA": round(i, 3),
+             "adjustment_mV": round(p["adjustment_mV"], 3)}
+            for p in profs for x, v, i in zip(p["positions_m"], p["residual_mV"], p["cab_mA"], strict=True)]
+
+
+def draw(study: Study, carrier: str, ballast: float, profs: Sequence[Mapping[str, Any]], path: str) -> str:
+    """Residual over cab current along the section, one line per profile, the relay's levels and the cab minimum;
+    '' or why the file could not be written."""
+    from liansuo.kit.plotfiles import new_figure, save_figure
+
+    params = layout_params(study.layout, carrier)
+    fig, (top, bottom) = new_figure(2, 1, sharex=True)
+    for n, p in enumerate(profs):
+        style: dict[str, Any] = ({"color": "black", "linewidth": 2.0, "zorder": 3} if n == 0
+                                 else {"linewidth": 1.1, "color": f"C{(n - 1) % 10}"})
+        top.plot(p["positions_m"], p["residual_mV"], label=f"{p['case']} (no train {p['adjustment_mV']:.0f} mV)",
+                 **style)
+        bottom.plot(p["positions_m"], p["cab_mA"], label=p["case"], **style)
+    for level, colour, name in ((params.pickup_mV, "tab:green", "pick-up"), (params.drop_mV, "tab:red", "drop")):
+        top.axhline(level, color=colour, linestyle="--", linewidth=1)
+        top.text(0.005, level, f" {name} {level:g} mV", color=colour, va="bottom", fontsize=8,
+                 transform=top.get_yaxis_transform())
+    top.set_ylim(0, max(params.pickup_mV * 1.15, max(max(p["residual_mV"]) for p in profs) * 1.1))
+    top.set_ylabel("receiver output (mV)")
+    top.set_title(f"ZPW-2000A {carrier}, {study.length_m:g} m {study.layout}, ballast {ballast:.3g} ohm*km, "
+                  f"{params.standard_shunt_ohm:g} ohm shunt at each point", fontsize=10)
+    top.legend(fontsize=7, loc="upper right", ncol=2)
+    least = params.cab_min(carrier)
+    bottom.axhline(least, color="tab:red", linestyle="--", linewidth=1)
+    bottom.text(0.995, least, f"cab minimum {least:g} mA ", color="tab:red", va="bottom", ha="right", fontsize=8,
+                transform=bottom.get_yaxis_transform())
+    bottom.set_ylim(0, max(max(p["cab_mA"]) for p in profs) * 1.1)
+    bottom.set_ylabel("cab-signal current (mA)")
+    bottom.set_xlabel("shunt position from the receiver end (m)")
+    bottom.set_xlim(0, study.length_m)
+    return save_figure(fig, path)
