@@ -12,7 +12,6 @@ row reproduced end to end).
 from __future__ import annotations
 
 import math
-import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -82,20 +81,19 @@ def _label(case: Mapping[int, str | float]) -> str:
 
 
 def run_study(study: Study) -> tuple[list[dict[str, Any]], dict[str, Any]]:
-    """The rows and the summary (configurations, seconds, configurations per second, per-quantity figures)."""
+    """The rows and the summary (the shunted configurations solved, per-quantity figures). How fast it runs is
+    ``liansuo bench``'s to say (``zpw_configs_per_s``): nothing here reads the clock."""
     rng = np.random.default_rng(study.seed)
     rows: list[dict[str, Any]] = []
     changes: dict[str, list[float]] = {q: [] for q in QUANTITIES}
-    configurations, seconds = 0, 0.0
+    configurations = 0
     for carrier in study.carriers:
         params = layout_params(study.layout, carrier)
         caps = standard_positions(study.length_m, None, params)
         cases = _cases(study, len(caps), rng)
         ballasts = _ballasts(study, params.ballast_ohm_km, rng)
-        t0 = time.perf_counter()
         r = sweep_section(study.length_m, caps, [carrier], ballasts, cases, params=params,
                           capacitance_uF=study.capacitance_uF)
-        seconds += time.perf_counter() - t0
         configurations += r.configurations
         least, drop = params.cab_min(carrier), params.drop_mV
         figures = {"adjustment_mV": r.adjustment_mV[0], "min_cab_current_mA": r.min_cab_current_mA[0],
@@ -116,7 +114,6 @@ def run_study(study: Study) -> tuple[list[dict[str, Any]], dict[str, Any]]:
     summary: dict[str, Any] = {
         "length_m": study.length_m, "layout": study.layout, "carriers": list(study.carriers),
         "faults": study.faults, "samples": study.samples, "rows": len(rows), "configurations": configurations,
-        "seconds": round(seconds, 3), "configurations_per_s": round(configurations / seconds) if seconds else None,
         "cab_under_minimum": sum(1 for r in rows if not r["cab_ok"]),
         "residual_over_drop": sum(1 for r in rows if not r["residual_ok"]), "quantities": quantities}
     for q in QUANTITIES:
@@ -138,8 +135,7 @@ def summary_text(summary: Mapping[str, Any]) -> str:
     what = f"Monte Carlo of {s['samples']}" if s["samples"] else f"faults: {s['faults']}"
     lines = [f"ZPW-2000A sweep: {s['length_m']:g} m {s['layout']} section, carriers {', '.join(s['carriers'])}, "
              f"{what}",
-             f"{s['rows']} rows, {s['configurations']:,} shunted configurations in {s['seconds']:.2f} s "
-             f"({s['configurations_per_s'] or 0:,}/s)",
+             f"{s['rows']} rows, {s['configurations']:,} shunted configurations",
              f"{'quantity':<20}{'min':>9}{'p5':>9}{'median':>9}{'p95':>9}{'max':>9}  largest rise / fall"]
     for q, e in s["quantities"].items():
         change = (f"  ↑{e['largest_rise_pct']:.1f} % ↓{e['largest_fall_pct']:.1f} %"
