@@ -182,6 +182,12 @@ class Station:
         """All the track of a section: a turnout section counts its main line and its branches."""
         return sum(self.track_length(t) for t in self.section_tracks[section])
 
+    def section_run(self, section: str) -> float:
+        """The length of a track circuit's main run: the longest way through the section from one of its ends to
+        another, over the tracks' lengths. A plain section is all its track; a turnout section's branches lie beside
+        its run (受电分支, 无受电分支), not after it, so they are not added to it."""
+        return self.derived(_section_runs)[section]
+
     def section_span(self, section: str) -> float:
         """How far a section reaches along the line, from its lowest to its highest point: the length of a track
         circuit's main run (a turnout section's branches lie beside it, not after it)."""
@@ -334,3 +340,19 @@ class Station:
         from liansuo.stations.topology import Topology  # networkx loads on first use: checking a file needs no graph
 
         return Topology(self)
+
+
+def _section_runs(station: Station) -> dict[str, float]:
+    """Every section's main run (:meth:`Station.section_run`): over the graph of its tracks (nodes the track ends,
+    edges weighted by length), the largest of the shortest distances between two of its nodes."""
+    import networkx as nx
+
+    out: dict[str, float] = {}
+    for section, tracks in station.section_tracks.items():
+        g = nx.Graph()
+        for t in tracks:
+            a, b = station.track_ports[t]
+            g.add_edge(a.node, b.node, weight=station.track_length(t))
+        out[section] = max((d for _, lengths in nx.all_pairs_dijkstra_path_length(g) for d in lengths.values()),
+                           default=0.0)
+    return out

@@ -231,7 +231,7 @@ def section_circuit(station: Station, section_id: str, params: ZpwParams = DEFAU
     if section.type.value != "zpw2000a" or section.carrier is None:
         raise ValueError(f"section {section_id} is not a ZPW-2000A section with a carrier")
     caps = section.capacitors
-    length = station.section_length(section_id)
+    length = station.section_run(section_id)  # the main run: a turnout section's branches lie beside it
     return adjusted_circuit(length, section.carrier, capacitor_positions(station, section_id, params, length), params,
                             capacitance_uF=caps.capacitance_uF if caps else None,
                             layout=section_layout(station, section_id))

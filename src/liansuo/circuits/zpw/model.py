@@ -422,6 +422,6 @@ def section_circuit(station: Station, section_id: str, params: ZpwParams = DEFAU
         raise ValueError(f"section {section_id} is not a ZPW-2000A section with a carrier")
     params = layout_params(section_layout(station, section_id), section.carrier, params)
     caps = section.capacitors
-    length = station.section_length(section_id)
+    length = station.section_run(section_id)  # the main run: a turnout section's branches lie beside it
     return ZpwCircuit(length, section.carrier, capacitor_positions(station, section_id, params, length), params,
                       capacitance_uF=caps.capacitance_uF if caps else None, transmitter_end=transmitter_end)
