@@ -276,7 +276,7 @@ class _Warner:
 
     def lengths(self) -> None:
         for s in self.st.model.sections:
-            length = self.st.section_length(s.id)
+            length = self.st.section_span(s.id)  # what the live field solves (and holds down past the range)
             if s.type is CircuitType.phase25hz and length > self.r.phase25hz_max_length_m:
                 self.warn(self.loc("sections", s.id), f"25 Hz section '{s.id}' is {metres(length)} long "
                           f"(limit about {metres(self.r.phase25hz_max_length_m)}): in dry ballast a train on it "
