@@ -241,7 +241,7 @@ def _neighbour(sim: World, args: list[str]) -> Result:
         return Result.refuse(f"usage: {USAGE['neighbour']}")
     link, action = args
     if link in sim.neighbours.station_lines:
-        why = sim.neighbours.station_action(link, action, sim.field.track_up)
+        why = sim.neighbours.station_action(link, action, sim.track_up)
         return Result.refuse(why) if why else Result.accept(f"neighbour on {link}: {action}")
     if link not in sim.neighbours.by_link:
         return Result.refuse(f"there is no virtual neighbour on block line '{link}'")
