@@ -162,14 +162,20 @@ async def _serve(server: FieldServer, host: str, port: int, ready: Callable[[], 
     lines: asyncio.Queue[str | None] = asyncio.Queue()
 
     def read_stdin() -> None:  # a thread: stdin blocks
-        for line in sys.stdin:
-            loop.call_soon_threadsafe(lines.put_nowait, line.rstrip("\n"))
-        loop.call_soon_threadsafe(lines.put_nowait, None)
+        try:
+            for line in sys.stdin:
+                loop.call_soon_threadsafe(lines.put_nowait, line.rstrip("\n"))
+            loop.call_soon_threadsafe(lines.put_nowait, None)
+        except RuntimeError:  # the serving ended, and its loop with it
+            pass
 
-    threading.Thread(target=read_stdin, daemon=True).start()
+    def listening() -> None:  # the instructor's lines are read once the device serves
+        ready()
+        threading.Thread(target=read_stdin, daemon=True).start()
+
     task = asyncio.current_task()
     if task is not None:
         for sig in (signal.SIGTERM,):
             loop.add_signal_handler(sig, task.cancel)
     with contextlib.suppress(asyncio.CancelledError):
-        await serve(server, host, port, ready=ready, lines=lines)
+        await serve(server, host, port, ready=listening, lines=lines)
