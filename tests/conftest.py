@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+
 import pytest
 
 import liansuo
@@ -9,6 +11,8 @@ import liansuo
 # The suite runs the Python sources, in a native build too (setup.py): its doubles replace methods at run time, which
 # compiled classes do not allow. tests/test_native.py compares the compiled modules with them (pytest -m native).
 liansuo.use_pure()
+
+from fieldsim import FieldSim, free_port  # noqa: E402
 
 from liansuo.simulation.sim import Simulation  # noqa: E402
 
@@ -72,3 +76,11 @@ def position(text: str, needle: str) -> tuple[int, int]:
 @pytest.fixture
 def jiaopei() -> Driver:
     return Driver(Simulation("jiaopei"))
+
+
+@pytest.fixture
+def field() -> Iterator[FieldSim]:
+    """``liansuo field-sim jiaopei`` in a second process on a free port (tests/fieldsim.py)."""
+    fs = FieldSim(free_port())
+    yield fs
+    fs.stop()

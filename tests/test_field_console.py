@@ -4,7 +4,6 @@ the change-over, a lost link in red, and the change-over in the recording."""
 from __future__ import annotations
 
 import json
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -12,20 +11,13 @@ import pytest
 pytest.importorskip("pymodbus", reason="the field extra (pymodbus) is not installed")
 
 from consoletest import SIZE, message, run
-from fieldsim import STATION, FieldSim, free_port
+from fieldsim import STATION, FieldSim
 
 from liansuo.classroom.passwords import hash_password
 from liansuo.fieldio import points
 from liansuo.fieldio.link import ModbusLink
 from liansuo.stations.loader import load
 from liansuo.tui.app import ConsoleApp
-
-
-@pytest.fixture
-def field() -> Iterator[FieldSim]:
-    fs = FieldSim(free_port())
-    yield fs
-    fs.stop()
 
 
 def _app(port: int, **kwargs: object) -> ConsoleApp:

@@ -11,7 +11,6 @@ import socket
 import subprocess
 import sys
 import threading
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -25,13 +24,6 @@ from liansuo.fieldio.link import ModbusLink
 from liansuo.fieldio.server import FieldServer, serve
 from liansuo.fieldio.yard import FieldYard
 from liansuo.simulation.sim import Simulation
-
-
-@pytest.fixture
-def field() -> Iterator[FieldSim]:
-    fs = FieldSim(free_port())
-    yield fs
-    fs.stop()
 
 
 def interlocking(port: int, timeout_s: float = 0.5) -> Simulation:

@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING
 
 from liansuo.kit.arguments import unwritable
 from liansuo.kit.exitcodes import Exit, bad_input, refuse
-from liansuo.kit.source import Diagnostic, StationError, read_text, read_yaml
+from liansuo.kit.source import Diagnostic, StationError
 from liansuo.stations.station import Station
 
 if TYPE_CHECKING:
@@ -69,19 +69,11 @@ def check_points(station: Station, path: str) -> tuple[list[Diagnostic], str]:
     from liansuo.fieldio import points
     from liansuo.rules import load_rules
 
-    rules = load_rules()
     try:
-        src = read_yaml(read_text(Path(path), "give the path of a point map ('liansuo field-map STATION' writes one)"),
-                        path)
-        errors: list[Diagnostic] = []
-        from liansuo.stations.validation import validate
-
-        pm = validate(src, points.PointMapFile, errors, "points", "docs/field-mode.md")
-        if pm is None:
-            return errors, ""
+        pm, src = points.read(Path(path))
     except StationError as exc:
         return exc.diagnostics, ""
-    found = points.check(pm, src, station, rules)
+    found = points.check(pm, src, station, load_rules())
     e = points.elements_of(pm)
     return found, (f"field control of {e.describe()} ({len(pm.inputs)} inputs, {len(pm.outputs)} outputs, "
                    f"{len(pm.codes)} code registers); every other element stays simulated")

@@ -51,22 +51,24 @@ MAX_COILS = 1968  # coils written in one request
 MAX_REGISTERS = 123  # registers written in one request
 
 
-class InputPoint(BaseModel):
-    """A discrete input: a relay contact the interlocking reads."""
+class _Point(BaseModel):
+    """Where a relay of an element is wired: its address in its table; the relay itself is the table's own."""
 
     model_config = ConfigDict(extra="forbid")
     at: int = Address
     element: str = Field(min_length=1, description="the section, turnout, signal or platform:side")
+
+
+class InputPoint(_Point):
+    """A discrete input: a relay contact the interlocking reads."""
+
     relay: InputRelay
     lamp: str | None = Field(None, description="DJ only: the lamp it proves (H, L, U, U2, B, A, L2)")
 
 
-class OutputPoint(BaseModel):
+class OutputPoint(_Point):
     """A coil: a relay the interlocking drives."""
 
-    model_config = ConfigDict(extra="forbid")
-    at: int = Address
-    element: str = Field(min_length=1, description="the section, turnout, signal or platform:side")
     relay: OutputRelay
     lamp: str | None = Field(None, description="lamp only: the lamp it lights")
 
@@ -196,14 +198,21 @@ def _scalar(value: object) -> str:
 
 
 # ---- reading and checking ------------------------------------------------------------------------------------------
-def load(path: Path, station: Station, rules: RuleSet) -> PointMap:
-    """The point map in ``path``, checked against ``station``; :class:`StationError` with every problem."""
+def read(path: Path) -> tuple[PointMapFile, Source]:
+    """The point map in ``path`` as its schema has it, with the places of its values; :class:`StationError` for a
+    file that cannot be read or does not follow the schema."""
     text = read_text(path, "give the path of a point map ('liansuo field-map STATION' writes one)")
     src = read_yaml(text, str(path))
     errors: list[Diagnostic] = []
     pm = validate(src, PointMapFile, errors, "points", "docs/field-mode.md")
     if pm is None:
         raise StationError(errors)
+    return pm, src
+
+
+def load(path: Path, station: Station, rules: RuleSet) -> PointMap:
+    """The point map in ``path``, checked against ``station``; :class:`StationError` with every problem."""
+    pm, src = read(path)
     problems = check(pm, src, station, rules)
     if any(d.severity == "error" for d in problems):
         raise StationError(problems)
