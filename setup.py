@@ -22,6 +22,30 @@ def compiled_modules() -> tuple[str, ...]:
     return tuple(module.MODULES)
 
 
+ROOT = Path(__file__).parent
+NEEDED = ("LICENSE", "docs/pypi.md", "src/liansuo/__init__.py")  # the licence, the long description, the package
+DATA = {".py", ".typed"}  # what may lie at the package's top level besides its folders
+
+
+def layout_problems(root: Path = ROOT) -> list[str]:
+    """What makes this tree unfit to build from: a file the wheel needs is missing, or a layer of the package is a
+    file instead of a folder (a checkout that turned links into text files, or a copy that lost folders). Setuptools
+    builds such a tree without a word and the wheel then fails on import."""
+    problems = [f"{name} is missing" for name in NEEDED if not (root / name).is_file()]
+    package = root / "src" / "liansuo"
+    if package.is_dir():
+        problems += [f"src/liansuo/{p.name} is a file, not a folder of the package" for p in sorted(package.iterdir())
+                     if p.is_file() and p.suffix not in DATA]
+    return problems
+
+
+def check_layout() -> None:
+    problems = layout_problems()
+    if problems:
+        raise SystemExit("liansuo cannot be built from this tree: " + "; ".join(problems) + ". Build from a complete "
+                         "checkout (git clone, or git checkout -- . to restore what is missing)")
+
+
 def native() -> dict[str, object]:
     """What ``setup`` takes for a native build, if asked for one."""
     if os.environ.get("LIANSUO_NATIVE", "") != "1":
@@ -35,4 +59,5 @@ def native() -> dict[str, object]:
     return {"ext_modules": mypycify([f"src/liansuo/{m}.py" for m in compiled_modules()], opt_level="3")}
 
 
+check_layout()
 setup(**native())

@@ -121,6 +121,8 @@ def test_xlsx_has_every_route_and_the_sign_off_block(tmp_path: Path, capsys: pyt
         text = "\n".join(" ".join(row) for row in values)
         for label in ("编制", "复核", "批准", "日期", "jiaopei.yaml", signed.sha256):
             assert label in text
+        # printed as a signed 联锁表 is: A4 landscape, one page wide
+        assert (int(ws.page_setup.paperSize), ws.page_setup.orientation) == (9, "landscape"), ws.title  # 9: A4
     assert seen == set(table.routes)
 
 

@@ -15,6 +15,7 @@ cache lacks a requirement, so the wheel can be neither built nor installed.
 
 from __future__ import annotations
 
+import json
 import os
 import re
 import shlex
@@ -23,7 +24,7 @@ import subprocess
 import sys
 import tomllib
 import zipfile
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -35,7 +36,7 @@ ROOT = Path(__file__).resolve().parents[1]
 BIN = "Scripts" if os.name == "nt" else "bin"
 # folders of the checkout the build does not read (the wheel is built from a copy, never from the checkout itself,
 # so no build/ folder is left behind and no stale build/lib can hide a file the package data misses)
-NOT_COPIED_AT_TOP = {".venv", ".git", "build", "dist", "tests", "docs"}
+NOT_COPIED_AT_TOP = {".venv", ".git", "build", "dist", "tests"}
 NOT_COPIED = {"__pycache__", ".pytest_cache", ".mypy_cache", ".ruff_cache", ".hypothesis"}
 # environment variables that would let the installed package see the checkout or another environment
 DROPPED_ENV = {"PYTHONPATH", "PYTHONHOME", "PYTHONSTARTUP", "VIRTUAL_ENV", "PYTHONUSERBASE"}
@@ -158,6 +159,7 @@ class Installed:
     work: Path
     env: dict[str, str] = field(repr=False)
     build_output: str = field(repr=False, default="")  # what 'pip wheel' printed
+    core: dict[str, subprocess.CompletedProcess[str]] = field(repr=False, default_factory=dict)  # see CORE_RUNS
 
     @property
     def python(self) -> str:
@@ -266,7 +268,22 @@ def install(tmp: Path) -> Installed:
     # pytest too, for the wheel's pytest11 entry point; bytecode is written as modules are first imported
     build_or_skip("installed", [*inst.pip, "install", "--no-compile", "--no-warn-script-location", inst.wheel,
                                 "pytest"], tmp, inst.env, [*project["project"]["dependencies"], "pytest"], tmp)
+    # what the core install alone does, before the console extra joins it for the console's own test
+    inst.core = {name: run(args(inst), inst.work, inst.env) for name, args in CORE_RUNS.items()}
+    extras = project["project"]["optional-dependencies"]["console"]
+    build_or_skip("installed the console extra", [*inst.pip, "install", "--no-compile", "--no-warn-script-location",
+                                                   f"{inst.wheel}[console]"], tmp, inst.env, extras, tmp)
     return inst
+
+
+# commands run on the core install (no extra), by name: what is installed, and what needs an extra
+CORE_RUNS: dict[str, Callable[[Installed], list[str]]] = {
+    "pip list": lambda i: [*i.pip, "list", "--format", "json"],
+    "tui": lambda i: [i.liansuo, "tui", "jiaopei"],
+    "serve": lambda i: [i.liansuo, "serve", "jiaopei"],
+    "verify --workers 2": lambda i: [i.liansuo, "verify", "jiaopei", "--workers", "2"],
+    "soak": lambda i: [i.liansuo, "soak", "jiaopei", "--steps", "200"],
+}
 
 
 def test_the_wheel_holds_the_package_liansuo_only_and_every_file_of_it(installed: Installed) -> None:
@@ -410,6 +427,27 @@ def test_a_plot_without_the_plot_extra_says_how_to_get_it(installed: Installed) 
     assert (installed.work / "x2jg.csv").read_text(encoding="utf-8").startswith("section,case,position_m,")
 
 
+def test_the_core_install_is_small_and_each_extra_is_named_where_it_is_needed(installed: Installed) -> None:
+    """The core (no extra) loads, verifies and soaks stations; the console, the classroom server and the cluster
+    are extras, and a command that needs one says which in one line with exit status 2."""
+    listed = installed.core["pip list"]
+    assert listed.returncode == 0, describe(listed, installed.work)
+    names = {d["name"].lower().replace("_", "-") for d in json.loads(listed.stdout)}
+    heavy = names & {"textual", "textual-serve", "websockets", "dask", "distributed", "aiohttp", "tornado"}
+    assert not heavy, f"the core install pulls in {sorted(heavy)}"
+    assert len(names) <= 25, f"the core install is {len(names)} packages: {sorted(names)}"
+    soak = installed.core["soak"]
+    assert soak.returncode == 0 and "0 violations" in soak.stdout, describe(soak, installed.work)
+    for name, extra, what in (("tui", "console", "the operator console"), ("serve", "serve", "the classroom server"),
+                              ("verify --workers 2", "cluster", "work on several processes")):
+        proc = installed.core[name]
+        assert proc.returncode == 2, describe(proc, installed.work)
+        command = name.split()[0]
+        assert proc.stderr.startswith(f"liansuo {command}: {what} needs the {extra} extra: "
+                                      f"pip install 'liansuo[{extra}]' ("), proc.stderr
+        assert proc.stderr.count("\n") == 1, proc.stderr
+
+
 def test_field_mode_without_the_field_extra_says_how_to_get_it(installed: Installed) -> None:
     """pymodbus is the field extra: field-sim and the console's --field stop with one line and exit status 2, while
     field-map and check --points, which need nothing more, work from the installed package."""
@@ -423,3 +461,19 @@ def test_field_mode_without_the_field_extra_says_how_to_get_it(installed: Instal
     out = must("liansuo check jiaopei --points map.yaml",
                [installed.liansuo, "check", "jiaopei", "--points", "map.yaml"], installed.work, installed.env)
     assert "field control of 16 sections, 7 turnouts, 11 signals" in out, out
+
+
+def test_a_tree_that_lost_a_layer_or_a_needed_file_does_not_build(installed: Installed,
+                                                                   tmp_path: Path) -> None:
+    """A checkout that turned a folder into a file (links checked out as text) or lost the licence fails to build
+    with a message, where setuptools alone would build a wheel without that layer and say nothing."""
+    source = copy_source(tmp_path / "source")
+    shutil.rmtree(source / "src" / "liansuo" / "tui")
+    (source / "src" / "liansuo" / "tui").write_text("../tui", encoding="utf-8")
+    (source / "LICENSE").unlink()
+    proc = run([sys.executable, "-m", "pip", "wheel", "--no-deps", "--wheel-dir", tmp_path / "dist", source], tmp_path,
+               clean_env())
+    assert proc.returncode != 0, describe(proc, tmp_path)
+    assert "liansuo cannot be built from this tree: LICENSE is missing; src/liansuo/tui is a file, not a folder of " \
+           "the package" in proc.stdout + proc.stderr, describe(proc, tmp_path)
+    assert not any((tmp_path / "dist").glob("*.whl")), "a wheel was left in dist"

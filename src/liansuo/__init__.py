@@ -38,7 +38,6 @@ if TYPE_CHECKING:
     from liansuo.stations.loader import load_text as load_station_text
     from liansuo.stations.station import Station
 
-__version__ = "0.1.0"
 
 _WHERE = {
     "Simulation": ("liansuo.simulation.sim", "Simulation"),
@@ -69,6 +68,9 @@ if os.environ.get("LIANSUO_PURE", "") == "1":
 
 
 def __getattr__(name: str) -> Any:
+    if name == "__version__":  # one source: the package metadata, written from pyproject.toml
+        from liansuo.kit.jsonreport import version
+        return version()
     where = _WHERE.get(name)
     if where is None:
         raise AttributeError(f"module 'liansuo' has no attribute {name!r}")

@@ -19,6 +19,8 @@ from liansuo.classroom import cli as exercise
 from liansuo.cli import completion, schemas
 from liansuo.fieldio import cli as fieldcli
 from liansuo.interlocking.table import cli as interlocking
+from liansuo.kit.exitcodes import Exit, refuse
+from liansuo.kit.extras import needed
 from liansuo.kit.jsonreport import version
 from liansuo.proving import cli as proving
 from liansuo.proving.explore import cli as explore
@@ -59,6 +61,20 @@ REGISTER: tuple[Callable[[Add], None], ...] = (
 )
 
 
+# the commands that need an extra (kit/extras.py), and the options that make a command need the cluster extra
+NEEDS = {"tui": "console", "replay": "console", "serve": "serve"}
+CLUSTER_OPTIONS = ("workers", "scheduler")
+
+
+def extra_of(args: argparse.Namespace) -> str | None:
+    """The extra the parsed command line needs beyond the core install, if any."""
+    if any(getattr(args, o, None) for o in CLUSTER_OPTIONS):
+        return "cluster"
+    if getattr(args, "verify", False) is True:  # replay --verify: no console
+        return None
+    return NEEDS.get(getattr(args, "command", None) or "")
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="liansuo", description="Station signalling and interlocking simulator (联锁)")
     p.add_argument("--version", action="version", version=f"liansuo {version()}")
@@ -83,6 +99,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         parser.print_help()
         print("liansuo: a COMMAND is needed (the list above)", file=sys.stderr)
         return 2
+    extra = extra_of(args)
+    why = needed(extra) if extra else None
+    if why:
+        return refuse(args.command, why, Exit.USAGE)
     try:
         return handler(args)
     except BrokenPipeError:  # e.g. piped into head

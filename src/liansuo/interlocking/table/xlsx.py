@@ -63,6 +63,7 @@ def write_xlsx(signed: SignedTable, path: Path) -> None:
             ws.cell(ws.max_row, 2).border = Border(bottom=_THIN)
         ws.print_title_rows = "2:2"
         ws.page_setup.orientation = "landscape"
+        ws.page_setup.paperSize = ws.PAPERSIZE_A4  # the signed 联锁表 is printed on A4, landscape
         ws.page_setup.fitToWidth = 1
         ws.page_setup.fitToHeight = 0
         ws.sheet_properties.pageSetUpPr.fitToPage = True

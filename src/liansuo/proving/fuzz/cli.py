@@ -18,6 +18,7 @@ from types import ModuleType
 
 from liansuo.kit.arguments import count, positive_int, positive_number, unwritable
 from liansuo.kit.exitcodes import Exit, refuse
+from liansuo.kit.extras import needed
 from liansuo.kit.jsonreport import report
 from liansuo.kit.output import deliver
 
@@ -51,6 +52,8 @@ def cmd_fuzz(args: argparse.Namespace) -> int:
     if find_spec("hypothesis") is None:
         return refuse("fuzz", "needs hypothesis, which comes with the fuzz extra: pip install 'liansuo[fuzz]'",
                       Exit.USAGE)
+    if args.kind == "console" and (why := needed("console")):  # it drives the console's widgets
+        return refuse("fuzz", why, Exit.USAGE)
     if args.output and (why := unwritable(Path(args.output))):
         return refuse("fuzz", why, Exit.USAGE)
     from liansuo.proving.fuzz.runner import as_text, run
