@@ -1,13 +1,15 @@
 """An assessment's report (:meth:`~liansuo.classroom.assessment.Assessment.report`) written for people and programs:
-JSON, plain text and a standalone HTML page (the standard library's ``html.escape``; no template engine).
+JSON, plain text and a standalone HTML page (the Jinja2 template ``report.html.j2``, every value escaped).
 ``write_report`` writes the three as ``STEM.json``, ``STEM.txt`` and ``STEM.html``."""
 
 from __future__ import annotations
 
 import json
-from html import escape
+from functools import cache
 from pathlib import Path
 from typing import Any
+
+from jinja2 import Environment, PackageLoader, Template, select_autoescape
 
 
 def _t(seconds: float | None) -> str:
@@ -64,42 +66,35 @@ def text_report(report: dict[str, Any]) -> str:
     return "\n".join(out) + "\n"
 
 
-def _table(head: list[str], rows: list[list[str]]) -> str:
-    th = "".join(f"<th>{escape(h)}</th>" for h in head)
-    body = "".join("<tr>" + "".join(f"<td>{escape(c)}</td>" for c in r) + "</tr>" for r in rows)
-    return f"<table><tr>{th}</tr>{body}</table>" if rows else "<p>none</p>"
+@cache
+def _template() -> Template:
+    env = Environment(loader=PackageLoader("liansuo.classroom", "."), autoescape=select_autoescape(["j2"]),
+                      trim_blocks=True, keep_trailing_newline=True)
+    return env.get_template("report.html.j2")
 
 
 def html_report(report: dict[str, Any]) -> str:
-    """The report as one HTML page (every text from the run escaped)."""
+    """The report as one HTML page (every text from the run escaped by the template)."""
     ex = report["exercise"]
-    faults = ", ".join(_faults(report)) or "none"
-    parts = [
-        f"<h1>{escape(ex['title'])}</h1>",
-        f"<p>{escape(_who(report))} &middot; {escape(report['station'])} &middot; difficulty "
-        f"{report['difficulty']} &middot; seed {report['seed']} &middot; {escape(_t(report['elapsed_s']))} of "
-        f"{escape(_t(report['time_limit_s']))} ({escape(report['ended'])})</p>",
-        f"<p>Faults: {escape(faults)}</p>",
-        "<h2>Score</h2>", _table(["part", "points"], [[a, b] for a, b in _score_rows(report)]),
-        "<h2>Goals</h2>", _table(["goal", "points", "met at"], [
+    sections = [
+        ("Score", ["part", "points"], [[a, b] for a, b in _score_rows(report)]),
+        ("Goals", ["goal", "points", "met at"], [
             [g["description"] or "; ".join(g["expect"]), f"{g['points']:g}", _t(g["met_at"])]
             for g in report["goals"]]),
-        "<h2>Findings</h2>", _table(["finding", "diagnosed at"], [
-            [f["finding"], _t(f["diagnosed_at"])] for f in report["findings"]]),
-        "<h2>Diagnoses</h2>", _table(["time", "diagnosis", "correct"], [
+        ("Findings", ["finding", "diagnosed at"], [[f["finding"], _t(f["diagnosed_at"])] for f in report["findings"]]),
+        ("Diagnoses", ["time", "diagnosis", "correct"], [
             [_t(d["t"]), d["diagnosis"], "yes" if d["correct"] else "no"] for d in report["diagnoses"]]),
-        "<h2>Unsafe actions</h2>", _table(["time", "command", "rule", "why"], [
+        ("Unsafe actions", ["time", "command", "rule", "why"], [
             [_t(u["t"]), u["command"], u["rule"], u["why"]] for u in report["unsafe"]]),
-        "<h2>Sealed buttons used (铅封计数)</h2>", _table(["button", "uses"], [
+        ("Sealed buttons used (铅封计数)", ["button", "uses"], [
             [k, str(n)] for k, n in sorted(report["sealed_uses"].items())]),
-        "<h2>Commands</h2>", _table(["time", "command", "accepted", "answer"], [
+        ("Commands", ["time", "command", "accepted", "answer"], [
             [_t(c["t"]), c["command"], "yes" if c["ok"] else "refused", c["answer"]] for c in report["commands"]]),
     ]
-    style = ("body{font-family:sans-serif;margin:2em}table{border-collapse:collapse}"
-             "td,th{border:1px solid #999;padding:2px 8px;text-align:left}")
-    return (f"<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>{escape(ex['title'])}: "
-            f"{escape(_who(report))}</title><style>{style}</style></head><body>\n" + "\n".join(parts)
-            + "\n</body></html>\n")
+    return _template().render(
+        title=ex["title"], who=_who(report), station=report["station"], difficulty=report["difficulty"],
+        seed=report["seed"], elapsed=_t(report["elapsed_s"]), limit=_t(report["time_limit_s"]), ended=report["ended"],
+        faults=", ".join(_faults(report)) or "none", sections=sections)
 
 
 def write_report(report: dict[str, Any], directory: str | Path, stem: str) -> list[Path]:

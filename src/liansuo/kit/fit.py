@@ -8,7 +8,7 @@ terminal must only receive what liansuo means to draw.
 
 from __future__ import annotations
 
-import unicodedata
+from rich.cells import cell_len
 
 from liansuo.kit.printable import printable_block
 
@@ -16,8 +16,9 @@ WIDTH = 100
 
 
 def columns(text: str) -> int:
-    """How many terminal columns ``text`` takes (wide and full-width characters take two)."""
-    return sum(2 if unicodedata.east_asian_width(c) in "WF" else 1 for c in text)
+    """How many terminal columns ``text`` takes, as a terminal draws it (rich's cell widths: wide and full-width
+    characters take two, combining marks none)."""
+    return cell_len(text)
 
 
 def fit(line: str, indent: str = "    ", width: int = WIDTH, keep: int = 1) -> str:

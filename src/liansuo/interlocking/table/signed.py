@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import hashlib
 import json
-import unicodedata
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -79,11 +78,6 @@ class SignedTable:
     def as_dict(self) -> list[dict[str, object]]:
         return [{"name": g.name, "direction": g.direction, "category": g.category, "throat": g.throat,
                  "rows": [{"id": r.route, **r.cells} for r in g.rows]} for g in self.groups]
-
-
-def cell_width(text: str) -> int:
-    """Display columns of ``text``: wide (CJK) characters take two."""
-    return sum(2 if unicodedata.east_asian_width(c) in "WF" else 1 for c in text)
 
 
 def station_identity(station: Station) -> tuple[str, str]:

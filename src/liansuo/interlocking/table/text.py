@@ -19,7 +19,8 @@ from collections.abc import Iterator
 from typing import TextIO
 
 from liansuo.interlocking.table.build import InterlockingTable
-from liansuo.interlocking.table.signed import COLUMNS, SignedTable, cell_width, signed_table
+from liansuo.interlocking.table.signed import COLUMNS, SignedTable, signed_table
+from liansuo.kit.fit import columns as cell_width
 from liansuo.kit.jsonreport import envelope
 from liansuo.kit.printable import printable_block
 
