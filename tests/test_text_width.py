@@ -45,7 +45,9 @@ def test_check_fits_100_columns(station: str) -> None:
                                   ("soak", "jiaopei", "--steps", "150"),
                                   ("run", "src/liansuo/examples/scenarios/jiaopei-receive-depart.yaml"),
                                   ("test", "src/liansuo/examples/scripts/jiaopei-interlocking-test.yaml"),
-                                  ("test", "-v", "src/liansuo/examples/scripts/dead-zone-hazard.yaml")])
+                                  ("test", "-v", "src/liansuo/examples/scripts/dead-zone-hazard.yaml"),
+                                  ("mutate", "--list"), ("exercise", "list"), ("zpw", "validate"),
+                                  ("explore", "src/liansuo/examples/stations/minimal.yaml", "--depth", "2")])
 def test_text_commands_fit_100_columns(args: tuple[str, ...]) -> None:
     out = liansuo(*args)
     assert out.strip()

@@ -14,8 +14,8 @@ from collections.abc import Callable
 from typing import Any
 
 from liansuo.kit.exitcodes import Exit, bad_input, refuse
+from liansuo.kit.fit import fit
 from liansuo.kit.jsonreport import print_report
-from liansuo.kit.printable import printable
 from liansuo.kit.source import StationError
 
 Handler = Callable[[argparse.Namespace], int]
@@ -60,8 +60,10 @@ def cmd_list(args: argparse.Namespace) -> int:
         return int(Exit.OK)
     width = max(len(r["name"]) for r in rows) if rows else 4
     print(f"{'name':<{width}}  {'station':<8} level  title")
+    lead = " " * (width + 18)  # a long title goes on under its own column
     for r in rows:
-        print(printable(f"{r['name']:<{width}}  {r['station']:<8} {r['difficulty']:<5}  {r['title']}"))
+        print(fit(f"{r['name']:<{width}}  {r['station']:<8} {r['difficulty']:<5}  {r['title']}", lead,
+                  keep=4))
     return int(Exit.OK)
 
 

@@ -20,7 +20,7 @@ from pathlib import Path
 
 from liansuo.kit.arguments import positive_int
 from liansuo.kit.exitcodes import Exit, bad_input, refuse
-from liansuo.kit.fit import fit_all
+from liansuo.kit.fit import fit, fit_all
 from liansuo.kit.jsonreport import print_report
 from liansuo.kit.native import native_modules
 from liansuo.kit.source import StationError
@@ -152,7 +152,7 @@ def cmd_mutate(args: argparse.Namespace) -> int:
         return refuse("mutate", f"no mutant {', '.join(unknown)}; 'liansuo mutate --list' names them", Exit.USAGE)
     if args.list:
         for m in MUTANTS:
-            print(f"{m.name:34} {m.what}")
+            print(fit(f"{m.name:34} {m.what}", " " * 35, keep=2))  # a long description under its own column
         return 0
     for spec in args.station or ():  # every station loads before any mutant runs
         try:
