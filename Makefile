@@ -4,7 +4,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: run test lint clean native test-native
+.PHONY: run test lint clean native test-native docs
 
 # Reinstall only when pyproject.toml or setup.py changed since the last install. The sumo extra (libsumo,
 # eclipse-sumo, about 230 MB) is installed too where it can be; where it cannot, the SUMO engine's tests skip and say
@@ -25,6 +25,10 @@ test: $(STAMP)
 	$(BIN)/python -m pytest -n auto --dist worksteal
 	$(BIN)/ruff check .
 	$(BIN)/mypy
+
+# The documentation site with the API reference from the docstrings (mkdocs.yml), into site/.
+docs: $(STAMP)
+	$(BIN)/mkdocs build --strict
 
 # The hot path compiled with mypyc (setup.py, docs/native.md): about 1.5-2x faster, the same results. Needs a C
 # compiler and Python's headers; `make clean` goes back to pure Python. `make test` runs the suite on the pure
