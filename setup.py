@@ -11,6 +11,7 @@ from importlib.util import module_from_spec, spec_from_file_location
 from pathlib import Path
 
 from setuptools import setup
+from setuptools.command.build_py import build_py
 
 
 def compiled_modules() -> tuple[str, ...]:
@@ -46,6 +47,18 @@ def check_layout() -> None:
                          "checkout (git clone, or git checkout -- . to restore what is missing)")
 
 
+class BuildWithDocs(build_py):
+    """The package as built, with the documentation pages (docs/*.md) in it as liansuo/docs/, where
+    ``liansuo docs TOPIC`` reads them wherever liansuo is installed."""
+
+    def run(self) -> None:
+        super().run()
+        target = Path(self.build_lib) / "liansuo" / "docs"
+        target.mkdir(parents=True, exist_ok=True)
+        for page in sorted((ROOT / "docs").glob("*.md")):
+            self.copy_file(str(page), str(target / page.name))
+
+
 def native() -> dict[str, object]:
     """What ``setup`` takes for a native build, if asked for one."""
     if os.environ.get("LIANSUO_NATIVE", "") != "1":
@@ -60,4 +73,4 @@ def native() -> dict[str, object]:
 
 
 check_layout()
-setup(**native())
+setup(cmdclass={"build_py": BuildWithDocs}, **native())

@@ -18,7 +18,7 @@ from liansuo.cli.main import build_parser
 
 SUBCOMMANDS = {"stations", "check", "schema", "generate", "table", "zpw", "25hz", "run", "test", "verify", "soak",
                "explore", "mutate", "fuzz", "bench", "tui", "replay", "serve", "completion", "exercise", "field-sim",
-               "field-map"}
+               "field-map", "docs"}
 
 
 def test_every_subcommand_is_registered() -> None:
@@ -85,3 +85,28 @@ def test_bash_completion_completes_subcommands_options_and_choices(tmp_path: Pat
     lines = proc.stdout.splitlines()
     assert lines[0].startswith("complete ") and lines[0].endswith(" liansuo"), lines
     assert lines[1:] == ["schema", "bash zsh fish", "text csv json xlsx"]
+
+
+def test_docs_lists_the_pages_and_prints_one(capsys: pytest.CaptureFixture[str]) -> None:
+    from liansuo.cli.main import main
+
+    assert main(["docs"]) == 0
+    listed = capsys.readouterr().out
+    assert "verify " in listed and "station-format " in listed and "pypi" not in listed
+    assert main(["docs", "verify"]) == 0
+    assert capsys.readouterr().out.startswith("# `liansuo verify`: the automatic interlocking test")
+    assert main(["docs", "verif"]) == 2
+    assert "no page 'verif'; did you mean verify?" in capsys.readouterr().err
+
+
+def test_help_names_pages_that_liansuo_docs_finds(capsys: pytest.CaptureFixture[str]) -> None:
+    """Every page a command's help names as 'liansuo docs TOPIC' exists: the help never points at a page an
+    installed liansuo lacks."""
+    import re
+
+    from liansuo.cli.docs import pages
+
+    sub = next(a for a in build_parser()._actions if isinstance(a, argparse._SubParsersAction))
+    helps = [" ".join(p.format_help().split()) for p in sub.choices.values()]  # across wrapped lines
+    named = {t for h in helps for t in re.findall(r"liansuo docs ([a-z0-9-]+)", h)}
+    assert named and named <= set(pages()), named - set(pages())

@@ -414,6 +414,14 @@ def test_version_completion_and_the_shipped_schemas(installed: Installed) -> Non
         assert printed == Path(path).read_text(encoding="utf-8"), f"liansuo schema {kind} differs from {path}"
 
 
+def test_the_documentation_pages_are_installed(installed: Installed) -> None:
+    """The help names pages as 'liansuo docs TOPIC': the wheel carries them, away from any checkout."""
+    listed = must("liansuo docs", [installed.liansuo, "docs"], installed.work, installed.env)
+    assert "station-format" in listed and "verify" in listed, listed
+    page = must("liansuo docs cluster", [installed.liansuo, "docs", "cluster"], installed.work, installed.env)
+    assert page.startswith("# Running verify and soak on many processes"), page[:200]
+
+
 def test_a_plot_without_the_plot_extra_says_how_to_get_it(installed: Installed) -> None:
     """The wheel's own dependencies leave matplotlib out: --plot then stops with one line and exit status 2, while
     --plot-csv, which needs nothing more, is written."""

@@ -26,8 +26,8 @@ def register(add: Add) -> None:
     sp.add_argument("--format", choices=("json", "text"), default="json", help="json (default) or text")
     sp.add_argument("--explore", action="store_true", help="instead, the figures of 'liansuo explore': saturation, "
                     "the depth reached on jiaopei in ten minutes, the mutation score of explore alone (the better part "
-                    "of an hour; with --quick minutes): docs/benchmark.md")
+                    "of an hour; with --quick minutes): 'liansuo docs benchmark'")
     sp.add_argument("--history", type=Path, metavar="FILE", help="also append the report to FILE as one line of JSON "
                     "with the time and the commit (the project keeps docs/benchmark-history.jsonl)")
     sp.add_argument("--scale", action="store_true", help="also verify, soak and write the table of large hubs "
-                    "(about a quarter of an hour in full on 2 cores; with --quick minutes): docs/benchmark.md")
+                    "(about a quarter of an hour in full on 2 cores; with --quick minutes): 'liansuo docs benchmark'")

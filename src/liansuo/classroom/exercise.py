@@ -167,7 +167,7 @@ def parse_exercise(path: str | Path) -> Exercise:
             LANGUAGE.read_steps(src, ("faults", key), raw_faults.get(key), errors)
     _diagnosis_lines(src, data, errors)
     _goal_lines(src, data, errors)
-    model = validate(src, ExerciseFile, errors, "exercise", "docs/exercises.md")
+    model = validate(src, ExerciseFile, errors, "exercise", "'liansuo docs exercises'")
     if errors or model is None:
         raise StationError(errors)
     goals = [ExerciseGoal(str(g.description).strip(), tuple(_expect(line) for line in g.expect), g.points)

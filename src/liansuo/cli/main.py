@@ -16,7 +16,7 @@ from liansuo.bench import cli as bench
 from liansuo.circuits.phase25 import cli as phase25cli
 from liansuo.circuits.zpw import cli as zpwcli
 from liansuo.classroom import cli as exercise
-from liansuo.cli import completion, schemas
+from liansuo.cli import completion, docs, schemas
 from liansuo.fieldio import cli as fieldcli
 from liansuo.interlocking.table import cli as interlocking
 from liansuo.kit.exitcodes import Exit, refuse
@@ -58,6 +58,7 @@ REGISTER: tuple[Callable[[Add], None], ...] = (
     exercise.register,  # exercise
     server.register,  # serve
     fieldcli.register,  # field-sim, field-map
+    docs.register,  # docs
 )
 
 

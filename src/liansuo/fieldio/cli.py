@@ -40,7 +40,7 @@ def address(text: str) -> tuple[str, int]:
 
 def register(add: Add) -> None:
     sp = add("field-sim", cmd_field_sim, "serve a station's simulated trackside equipment over Modbus TCP, for an "
-                                        "interlocking in field mode (docs/field-mode.md)")
+                                        "interlocking in field mode ('liansuo docs field-mode')")
     sp.add_argument("station", help="bundled station name or path to a station YAML file")
     sp.add_argument("--modbus", type=address, required=True, metavar="HOST:PORT",
                     help="where to listen, e.g. 127.0.0.1:5020 (0.0.0.0 listens on every network)")

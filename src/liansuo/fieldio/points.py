@@ -204,7 +204,7 @@ def read(path: Path) -> tuple[PointMapFile, Source]:
     text = read_text(path, "give the path of a point map ('liansuo field-map STATION' writes one)")
     src = read_yaml(text, str(path))
     errors: list[Diagnostic] = []
-    pm = validate(src, PointMapFile, errors, "points", "docs/field-mode.md")
+    pm = validate(src, PointMapFile, errors, "points", "'liansuo docs field-mode'")
     if pm is None:
         raise StationError(errors)
     return pm, src
@@ -265,7 +265,7 @@ def check(pm: PointMapFile, src: Source, station: Station, rules: RuleSet) -> li
                 continue
             why = _relay_problem(p, kind, plan.lamps, flashers, counters)
             if why:
-                out.append(src.diagnostic(loc, why, "docs/field-mode.md lists each element's relays"))
+                out.append(src.diagnostic(loc, why, "'liansuo docs field-mode' lists each element's relays"))
                 continue
             key = (p.element, p.relay, p.lamp)
             if key in seen:

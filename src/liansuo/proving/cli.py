@@ -153,7 +153,7 @@ def register_run(add: Add) -> None:
     sp.add_argument("--until", metavar="DURATION", help="keep running to this simulated time (e.g. 10min)")
     sp.add_argument("--engine", choices=("kinematic", "sumo"), default="kinematic",
                     help="what moves the trains: the built-in kinematic model (default) or Eclipse SUMO "
-                         "(pip install 'liansuo[sumo]'; see docs/sumo.md)")
+                         "(pip install 'liansuo[sumo]'; 'liansuo docs sumo')")
     sp.add_argument("--format", choices=FORMATS, default="text", help="text (default: the event log) or json")
     add_plot_options(sp, "time-distance and speed-distance plots of the trains")
 

@@ -49,7 +49,7 @@ def parse_scenario(path: Path) -> Scenario:
         raise StationError([src.diagnostic((), "a scenario is a mapping with 'station:' and 'steps:'", "")])
     errors: list[Diagnostic] = []
     steps = LANGUAGE.read_steps(src, ("steps",), data.get("steps"), errors)
-    model = validate(src, ScenarioFile, errors, "scenario", "docs/trains.md")
+    model = validate(src, ScenarioFile, errors, "scenario", "'liansuo docs trains'")
     if errors or model is None:
         raise StationError(errors)
     return Scenario(str(path), model.station, str(model.description), steps, model.until)

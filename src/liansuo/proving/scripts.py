@@ -100,7 +100,7 @@ def parse_script(path: Path) -> Script:
     tests_raw = data.get("tests")
     steps = [LANGUAGE.read_steps(src, ("tests", i, "steps"), t.get("steps") if isinstance(t, dict) else None, errors)
              for i, t in enumerate(tests_raw if isinstance(tests_raw, list) else [])]
-    model = validate(src, ScriptFile, errors, "script", "docs/commands.md")
+    model = validate(src, ScriptFile, errors, "script", "'liansuo docs commands'")
     if errors or model is None:
         raise StationError(errors)
     tests = [ScriptTest(t.name, [Step(text, line) for text, line in lines], src.mark(("tests", i)).line)

@@ -37,8 +37,8 @@ def client(workers: int, scheduler: str | None) -> Iterator[Any]:
             c = Client(scheduler, timeout=CONNECT_S)  # type: ignore[no-untyped-call]
         except (OSError, TimeoutError, ValueError) as exc:
             raise SpreadError(f"cannot reach the Dask scheduler at {scheduler} ({exc}); start one with 'dask "
-                              "scheduler' and workers with 'dask worker ADDRESS' (docs/cluster.md), or leave out "
-                              "--scheduler to run here") from None
+                              "scheduler' and workers with 'dask worker ADDRESS' ('liansuo docs cluster'), or leave "
+                              "out --scheduler to run here") from None
         with c:
             yield c
         return

@@ -61,7 +61,7 @@ def read(path: Path) -> RuleFile:
     try:
         root = compose(read_file(path))
     except YamlProblem as exc:
-        message = ("no such file: every rule set has this file (see docs/rules.md)" if exc.what == "missing"
+        message = ("no such file: every rule set has this file ('liansuo docs rules')" if exc.what == "missing"
                    else exc.message)
         raise RuleError([Problem(rf.file, exc.line, exc.column, message)]) from None
     if root is None or root.tag != "tag:yaml.org,2002:map":

@@ -29,7 +29,7 @@ def changeover(world: World, args: list[str]) -> Result:
     control = world.control
     if control is None:
         return Result.refuse("this station has no field link: start it with a field to change over to "
-                             "(liansuo tui STATION --field HOST:PORT, docs/field-mode.md)")
+                             "(liansuo tui STATION --field HOST:PORT, 'liansuo docs field-mode')")
     if control.up == to_field:
         return Result.refuse(f"already in {'field' if to_field else 'simulated'} control")
     why = refuses(world)

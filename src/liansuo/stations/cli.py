@@ -113,7 +113,7 @@ def register(add: Add, more_warnings: tuple[Warnings, ...] = (), more_errors: tu
     if points_check is not None:
         sp.set_defaults(points_check=points_check)
         sp.add_argument("--points", metavar="FILE", help="also check this field I/O point map against the station "
-                                                         "(docs/field-mode.md)")
+                                                         "('liansuo docs field-mode')")
     sp = add("generate", cmd_generate, "write a generated station file (a hub of any size, for stress tests)")
     sp.add_argument("kind", choices=("hub",), help="what to generate: 'hub', a double-ended yard of parallel tracks")
     sp.add_argument("--turnouts", type=positive_int, required=True, metavar="N", help="turnouts in the hub")

@@ -135,7 +135,7 @@ class _Checker:
                 if tid in taken:
                     self.err((KEY, i, "id"), f"double slip {s.id}: the id '{tid}' of its inner track is already used "
                              f"by {taken[tid]}", "rename that track: a double slip ID names its four inner tracks "
-                             "ID_LOW-HIGH (docs/station-format.md)")
+                             "ID_LOW-HIGH ('liansuo docs station-format')")
                 taken.setdefault(tid, f"double slip {s.id}")
 
     def sections(self) -> None:

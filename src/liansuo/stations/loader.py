@@ -28,7 +28,7 @@ def parse_source(src: Source, rules: RuleSet | None = None) -> Station:
     check_kind(src, "station")
     if not isinstance(src.data, dict):
         raise StationError([src.diagnostic((), "a station file is a mapping of keys such as 'id:' and 'tracks:'",
-                                           "see docs/station-format.md for a small complete example")])
+                                           "'liansuo docs station-format' for a small complete example")])
     try:
         # JSON mode keeps strictness (no "1" -> 1) while accepting enum values written as text
         model = StationFile.model_validate_json(json.dumps(src.data, default=str), by_alias=True)

@@ -15,8 +15,8 @@ from liansuo.kit.source import Diagnostic, Source
 M = TypeVar("M", bound=BaseModel)
 
 _HINTS = {
-    "extra_forbidden": "remove it, or check its spelling against 'liansuo schema' and docs/station-format.md",
-    "missing": "add this key; docs/station-format.md lists what each item needs",
+    "extra_forbidden": "remove it, or check its spelling against 'liansuo schema' and 'liansuo docs station-format'",
+    "missing": "add this key; 'liansuo docs station-format' lists what each item needs",
     "enum": "use one of the values listed",
     "literal_error": "use one of the values listed",
     "string_type": "write a text value",
@@ -35,7 +35,7 @@ _HINTS = {
     "less_than_equal": "write a smaller number",
     "finite_number": "write an ordinary number (not .nan or .inf)",
 }
-_DEFAULT_HINT = "docs/station-format.md explains what this key takes"
+_DEFAULT_HINT = "'liansuo docs station-format' explains what this key takes"
 
 
 def _describe(err: Any) -> str:

@@ -46,7 +46,7 @@ def register(add: Add, connect: Handler | None = None) -> None:
                          "shows it")
     sp.add_argument("--mute", action="store_true", help="start with the alarm bell muted (m or 'unmute' turns it on)")
     fld = sp.add_argument_group("field mode", "the interlocking against field equipment over Modbus TCP "
-                                              "(docs/field-mode.md)")
+                                              "('liansuo docs field-mode')")
     fld.add_argument("--field", metavar="HOST:PORT",
                      help="the field's Modbus TCP address (an I/O module, a PLC, or 'liansuo field-sim'); the console "
                           "starts in simulated control and 'changeover field' (QHA) changes over")
@@ -55,7 +55,7 @@ def register(add: Add, connect: Handler | None = None) -> None:
     fld.add_argument("--changeover-password-file", metavar="FILE",
                      help="with --field: QHA's password (a hash from 'liansuo serve --hash-password', or the "
                           "password); else LIANSUO_CHANGEOVER_PASSWORD")
-    room = sp.add_argument_group("classroom", "the console as a client of 'liansuo serve' (docs/classroom.md)")
+    room = sp.add_argument_group("classroom", "the console as a client of 'liansuo serve' ('liansuo docs classroom')")
     room.add_argument("--connect", metavar="URL",
                       help="connect to the classroom server at URL (ws://HOST:PORT): the station and the clock are "
                            "the server's; without --seat or --instructor a login screen asks")

@@ -144,7 +144,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     given = [opt for opt, value in (("--fault", args.fault), ("--section", args.section), ("--strict", args.strict),
                                     ("--sensitivity", args.sensitivity)) if value]
     if given:
-        return refuse("zpw", f"{given[0]} does not go with 'sweep' (its options: docs/zpw2000a.md, 'Sweeps')",
+        return refuse("zpw", f"{given[0]} does not go with 'sweep' (its options: 'liansuo docs zpw2000a', 'Sweeps')",
                       Exit.USAGE)
     if args.output and (why := unwritable(Path(args.output))):
         return refuse("zpw", why, Exit.USAGE)
@@ -211,7 +211,7 @@ def register(add: Callable[[str, Callable[[argparse.Namespace], int], str], argp
     sp.add_argument("--sensitivity", action="store_true", help="with 'validate': also how the score moves with each "
                     "parameter the article does not publish")
     study = sp.add_argument_group("sweep", "liansuo zpw sweep: one section over carriers, ballasts, capacitor faults "
-                                           "or a Monte Carlo of tolerances (docs/zpw2000a.md, 'Sweeps')")
+                                           "or a Monte Carlo of tolerances ('liansuo docs zpw2000a', 'Sweeps')")
     study.add_argument("--length", type=float, metavar="M", help="the section's length (default 1400 m)")
     study.add_argument("--layout", choices=("conventional", "passenger-line", "passenger-station"),
                        help="whose standard capacitors and design ballast (default conventional)")

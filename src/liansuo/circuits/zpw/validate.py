@@ -272,7 +272,7 @@ def as_text(rows: Sequence[Mapping[str, Any]], path: Path = DATA_FILE) -> str:
     names = {s.id: s for s in read_article(path).sections}
     lines = ["ZPW-2000A model against Luo Ying 2023 (capacitor faults, tables 1 and 2): largest rise and fall in %",
              "over every carrier and every single faulted capacitor, design ballast; ratio model/article;",
-             "size: within 1.5x (3 points under 5 %); trend: direction only (docs/zpw2000a.md)",
+             "size: within 1.5x (3 points under 5 %); trend: direction only ('liansuo docs zpw2000a')",
              f"{'t':<1} {'section':<26} {'fault':<5} {'quantity':<15} {'paper %':>12} {'model %':>12} {'ratio':>9} "
              "size trend"]
     for r in rows:
@@ -346,7 +346,7 @@ def sensitivity(path: Path = DATA_FILE) -> list[dict[str, Any]]:
 
 
 def sensitivity_text(found: Sequence[Mapping[str, Any]]) -> str:
-    lines = ["sensitivity to the parameters the article does not publish (docs/zpw2000a.md):",
+    lines = ["sensitivity to the parameters the article does not publish ('liansuo docs zpw2000a'):",
              f"{'parameter':<30} {'change':<26} {'size':>4} {'trend':>5} {'cab rise %':>10} {'cab < min':>10}"]
     for f in found:
         lines.append(f"{f['parameter']:<30} {f['change']:<26} {f['magnitude_ok']:>4} {f['trend_ok']:>5} "

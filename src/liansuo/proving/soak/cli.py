@@ -217,5 +217,6 @@ def register(add: Add) -> None:
     sp.add_argument("--workers", type=count, default=0, metavar="N",
                     help="fan the runs out on Dask over N local worker processes (default: run here)")
     sp.add_argument("--scheduler", metavar="ADDRESS",
-                    help="run on the Dask cluster whose scheduler is at ADDRESS (tcp://host:8786); docs/cluster.md")
+                    help="run on the Dask cluster whose scheduler is at ADDRESS (tcp://host:8786); "
+                         "'liansuo docs cluster'")
     sp.set_defaults(handler=cmd_soak)

@@ -50,10 +50,11 @@ def register(add: Add) -> None:
     sp.add_argument("--no-pairs", action="store_true", help="skip the pairs of routes")
     sp.add_argument("--simulate-all-pairs", action="store_true",
                     help="set and open together every compatible pair, also those apart (sharing no element), which "
-                    "are otherwise proven without a simulation; slower on a large station (docs/verify.md)")
+                    "are otherwise proven without a simulation; slower on a large station ('liansuo docs verify')")
     sp.add_argument("-v", "--verbose", action="store_true", help="print the steps that reproduce each failure")
     sp.add_argument("--workers", type=count, default=0, metavar="N",
                     help="fan the test out on Dask over N local worker processes (default: run here, in one)")
     sp.add_argument("--scheduler", metavar="ADDRESS",
-                    help="run on the Dask cluster whose scheduler is at ADDRESS (tcp://host:8786); docs/cluster.md")
+                    help="run on the Dask cluster whose scheduler is at ADDRESS (tcp://host:8786); "
+                         "'liansuo docs cluster'")
     sp.set_defaults(handler=cmd_verify)

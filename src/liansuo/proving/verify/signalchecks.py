@@ -160,7 +160,8 @@ class SignalChecks(RouteItems):
             if shown == flashing:
                 self.ctx.warnings.append(Failure(
                     "flasher", r.id, f"signal {r.signal} has a relay flasher (SNJ/SNJJ): a bad SNJ contact darkens the "
-                    f"flashing lamp and the interlocking keeps commanding {flashing} (see docs/faults.md)", p.script()))
+                    f"flashing lamp and the interlocking keeps commanding {flashing} ('liansuo docs faults')",
+                    p.script()))
             return
         want = self.ctx.rules.aspects.downgrade.get(flashing, {}).get("flasher", "")
         self.rt.check(shown == want, "flasher", f"{flashing} flasher of {r.signal} failed: the signal shows {shown}, "

@@ -46,7 +46,7 @@ from liansuo.stations.station import Station
 
 _JSON: TypeAdapter[Any] = TypeAdapter(Any)  # any JSON value, parsed by pydantic (bounded nesting, no RecursionError)
 _JSON_AT = re.compile(r" at line \d+ column (\d+)$")
-DOC = "docs/console.md, 'The recording file'"
+DOC = "'liansuo docs console', 'The recording file'"
 RECORD_AGAIN = "record the session again with 'liansuo tui --record FILE'"
 
 
