@@ -30,7 +30,7 @@ from typing import IO, Any
 
 from liansuo.interlocking.io import Result
 from liansuo.simulation.recording.file import Recording, RecordingError, load_recording, station_reference
-from liansuo.simulation.recording.schema import FORMAT, VERSION
+from liansuo.simulation.recording.schema import FORMAT, MAX_COMMAND_CHARS, VERSION
 from liansuo.simulation.sim import Simulation
 
 Record = dict[str, Any]
@@ -155,7 +155,7 @@ class Recorder:
                 self.write(record)
 
     def _command_done(self, n: int, t: float, line: str, result: Result) -> None:
-        self.write({"k": "cmd", "i": self.commands, "n": n, "t": t, "line": line, "ok": result.ok,
+        self.write({"k": "cmd", "i": self.commands, "n": n, "t": t, "line": line[:MAX_COMMAND_CHARS], "ok": result.ok,
                     "msg": result.message, "by": self.source})
 
     def _command_changes(self, changes: State) -> None:

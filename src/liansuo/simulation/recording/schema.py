@@ -14,6 +14,7 @@ from typing import Annotated, Literal
 from pydantic import BaseModel, ConfigDict, Field, TypeAdapter
 
 from liansuo.kit.filekind import RECORDING_FORMAT
+from liansuo.simulation.language import MAX_LINE_CHARS as MAX_LINE_CHARS_OF_A_COMMAND
 
 FORMAT = RECORDING_FORMAT  # the header's "format": how kit/filekind.py tells a recording from other files
 VERSION = 2  # 2: the station's digest, its path relative to the recording, commands numbered (cmd "i", end "cmds")
@@ -34,8 +35,9 @@ MAX_LINE_CHARS = 8 * 1024 * 1024
 MAX_STATION_CHARS = 4096
 # An element id, an aspect or a state in a record; a station's ids are far shorter.
 MAX_ID_CHARS = 200
-# A command line and its answer, as the console's command bar or a script sends them.
-MAX_COMMAND_CHARS = 10_000
+# A command line and its answer, as the console's command bar or a script sends them: a line past the language's
+# limit is recorded cut one character past it, which the language refuses in the same words on replay.
+MAX_COMMAND_CHARS = MAX_LINE_CHARS_OF_A_COMMAND + 1
 MAX_ANSWER_CHARS = 100_000
 # Diagnostics listed for one file before the rest are left out.
 MAX_ERRORS = 20
