@@ -91,6 +91,9 @@ class Recorder:
 
     def header(self) -> None:
         station, digest = station_reference(self.sim.station, self.path)
+        if not digest:  # the replay checks the station by this digest: a recording without one is refused
+            raise ValueError(f"station {self.sim.station.id} was not read from a file: a recording names its station's "
+                             "file and its SHA-256; load the station from a file to record it")
         self.write({"k": "header", "format": FORMAT, "version": VERSION, "station": station,
                     "station_id": self.sim.station.id, "station_sha256": digest,
                     "cycle_s": self.sim.cycle_s, "t0": self.sim.t})
