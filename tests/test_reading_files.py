@@ -4,6 +4,7 @@ from wherever it is run. Each test is a reproducer of the issue, run as a user r
 
 from __future__ import annotations
 
+import hashlib
 import json
 import os
 import re
@@ -74,8 +75,9 @@ def test_the_alias_bomb_is_refused_through_a_script_or_a_scenario_too(
 def test_the_alias_bomb_is_refused_through_a_recording_header(
         tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     bomb = written(tmp_path, BOMB + MINIMAL, "bomb.yaml")
-    records = [{"k": "header", "format": "liansuo-recording", "version": 2, "station": str(bomb),
-                "station_id": "minimal", "station_sha256": "", "cycle_s": 0.25, "t0": 0.0},
+    digest = hashlib.sha256(bomb.read_bytes()).hexdigest()
+    records = [{"k": "header", "format": "liansuo-recording", "version": 2, "station": bomb.name,
+                "station_id": "minimal", "station_sha256": digest, "cycle_s": 0.25, "t0": 0.0},
                {"k": "init", "n": 0, "t": 0.0, "in": {}, "out": {}}, {"k": "end", "n": 0, "t": 0.0, "cmds": 0}]
     header = "".join(json.dumps(r) + "\n" for r in records)
     code, _, err = run(capsys, "replay", str(written(tmp_path, header, "rec.jsonl")), "--verify")

@@ -148,3 +148,16 @@ def test_a_malformed_exercise_is_reported_at_its_line(tmp_path: Path) -> None:
     text = "\n".join(str(d) for d in err.value.diagnostics)
     assert "unknown command 'flip'" in text and ":4:" in text
     assert "unknown key 'colour'" in text
+
+
+def test_a_command_line_past_the_languages_limit_is_recorded_and_replays(tmp_path: Path) -> None:
+    """A 300,000-character line sent at the console is refused by the language (issue 45, item 8); the recording keeps
+    it cut one character past the limit, so it stays readable and the replay is refused in the same words."""
+    path = tmp_path / "long.jsonl"
+    sim = Simulation("jiaopei")
+    rec = FileRecorder(sim, path).attach()
+    sim.run(1)
+    assert not sim.command("route X XI '" + "a" * 300_000 + "'").ok
+    assert sim.command("route X XI").ok
+    rec.close()
+    assert Replayer(load_recording(path)).verify() == []

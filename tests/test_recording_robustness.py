@@ -6,7 +6,10 @@ was made on."""
 from __future__ import annotations
 
 import json
+import os
 import shutil
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -17,6 +20,7 @@ from liansuo.simulation.recording import file as recordingfile
 from liansuo.simulation.recording.recorder import FileRecorder
 from liansuo.simulation.recording.schema import MAX_ERRORS
 from liansuo.stations.library import bundled
+from liansuo.stations.loader import load_text
 
 STEPS = ("route X XI", "run 2s", "occupy IAG", "run 5s", "release X", "route S SI", "fault no-indication 5",
          "run 10s")
@@ -121,8 +125,13 @@ def test_a_device_or_a_folder_is_refused_as_a_recording_and_as_its_station(
     write(path, edit(lines, 0, station="/dev/zero"))
     code, _, err = replay(capsys, str(path))
     assert code == 3
-    assert "the recording was made on station jiaopei, and the station file it names, /dev/zero, is not a regular " \
-           "file" in err and "--station" in err
+    assert "names its station as /dev/zero, outside the recording's folder" in err and "--station" in err
+    os.mkfifo(path.parent / "fifo.yaml")  # beside the recording: read never, a pipe would wait
+    write(path, edit(lines, 0, station="fifo.yaml"))
+    code, _, err = replay(capsys, str(path))
+    assert code == 3
+    assert "the recording was made on station jiaopei, and the station file it names, fifo.yaml " in err
+    assert "is not a regular file" in err and "--station" in err
 
 
 @pytest.mark.parametrize("n", [10**9, 2**31, 345_601, -1])
@@ -290,3 +299,70 @@ def test_a_badly_damaged_file_lists_its_first_errors_only(session: tuple[Path, l
     code, _, err = replay(capsys, str(path))
     assert code == 3 and err.count("not a JSON record") == MAX_ERRORS
     assert f"{path}:{3 + MAX_ERRORS}:1: error: the lines from here not checked after {MAX_ERRORS} errors" in err
+
+
+SECRET = "api_key: do-not-show-this-line\n"
+
+
+def replay_process(*argv: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([sys.executable, "-m", "liansuo", "replay", *argv, "--verify"], capture_output=True,
+                          text=True, check=False, timeout=120)
+
+
+@pytest.mark.parametrize("where", ["absolute", "parent", "symlink"])
+def test_a_recordings_station_outside_its_folder_is_refused_unread(tmp_path: Path, where: str) -> None:
+    """Issue 45, item 8: a recording naming /etc/shadow or ../.. as its station had that file read as a station and
+    its lines echoed ('/etc/shadow:1:1: error: unknown key ...'). Its station is a bundled name or a file in its own
+    folder; anything else is refused naming the path only, and replays when given on the command line."""
+    secret = tmp_path / "secret.yaml"
+    secret.write_text(SECRET, encoding="utf-8")
+    folder = tmp_path / "recordings"
+    folder.mkdir()
+    path = folder / "s.jsonl"
+    lines = record(path)
+    named = {"absolute": str(secret), "parent": "../secret.yaml", "symlink": "link.yaml"}[where]
+    if where == "symlink":
+        (folder / "link.yaml").symlink_to(secret)
+    write(path, edit(lines, 0, station=named))
+    proc = replay_process(str(path))
+    assert proc.returncode == 3, proc.stderr
+    assert proc.stderr.startswith(f"{path}:1:1: error: the recording names its station as {named}, outside the "
+                                  "recording's folder"), proc.stderr
+    assert "--station" in proc.stderr and "do-not-show" not in proc.stdout + proc.stderr
+    assert "Traceback" not in proc.stderr
+
+
+def test_a_station_elsewhere_replays_when_given_on_the_command_line(tmp_path: Path) -> None:
+    stations, recordings = tmp_path / "stations", tmp_path / "recordings"
+    stations.mkdir()
+    recordings.mkdir()
+    station = stations / "jiaopei.yaml"
+    shutil.copy(bundled()["jiaopei"], station)
+    path = recordings / "s.jsonl"
+    record(path, str(station))
+    assert json.loads(path.read_text(encoding="utf-8").splitlines()[0])["station"] == "../stations/jiaopei.yaml"
+    refused = replay_process(str(path))
+    assert refused.returncode == 3 and "outside the recording's folder" in refused.stderr
+    assert "--station" in refused.stderr and str(recordings / "../stations/jiaopei.yaml") in refused.stderr
+    given = replay_process(str(path), "--station", str(station))
+    assert given.returncode == 0, given.stderr
+    beside = recordings / "jiaopei.yaml"  # a station beside the recording replays as it is named
+    shutil.copy(station, beside)
+    record(path, str(beside))
+    assert replay_process(str(path)).returncode == 0
+
+
+def test_an_empty_station_digest_is_refused(session: tuple[Path, list[str]],
+                                            capsys: pytest.CaptureFixture[str]) -> None:
+    """An empty station_sha256 turned the check of the station off: any file with the station's id replayed."""
+    path, lines = session
+    write(path, edit(lines, 0, station_sha256=""))
+    code, _, err = replay(capsys, str(path))
+    assert code == 3 and f"{path}:1:" in err and "station_sha256 is empty" in err and "record the session again" in err
+
+
+def test_a_station_read_from_no_file_cannot_be_recorded(tmp_path: Path) -> None:
+    """The recorder never writes a recording without its station's digest (issue 45, item 8)."""
+    sim = Simulation(load_text(bundled()["jiaopei"].read_text(encoding="utf-8")))
+    with pytest.raises(ValueError, match="was not read from a file"):
+        FileRecorder(sim, tmp_path / "s.jsonl").attach()

@@ -107,3 +107,24 @@ def test_a_number_that_is_not_finite_is_refused_in_every_rule_file(folder: Path)
         load_rules(str(folder))
     text = str(exc.value)
     assert "interlocking.yaml:8:" in text and "driving.yaml:" in text and text.count("finite number") >= 2, text
+
+
+@pytest.mark.parametrize(("file", "old", "new", "said"), [
+    ("interlocking.yaml", "overlap_release_s: 180", "overlap_release_s: 100000000",
+     "overlap_release_s: Input should be less than or equal to 600"),
+    ("interlocking.yaml", "  other: 1", "  other: " + "9" * 400, "other: Input should be less than or equal to 10000"),
+    ("driving.yaml", "stop_margin_m: 8", "stop_margin_m: " + "9" * 400,
+     "stop_margin_m: a number this large is out of every range"),
+    ("design.yaml", "coding_speed_kmh: 45.0", "coding_speed_kmh: 1.0e+300",
+     "coding_speed_kmh: Input should be less than or equal to 400"),
+    ("equipment.yaml", "rated_force_N: 2450", "rated_force_N: 1.0e+12",
+     "rated_force_N: Input should be less than or equal to 100000"),
+], ids=["timer", "count", "distance", "speed", "force"])
+def test_a_number_out_of_its_range_is_refused_in_a_rule_file(folder: Path, file: str, old: str, new: str,
+                                                              said: str) -> None:
+    """Every number of a rule file has a range (docs/rules.md), as a station file's have (issue 45, item 6): a
+    release of three years or a margin of 400 digits would reach every timer and distance the rule sets."""
+    edit(folder / file, old, new)
+    with pytest.raises(RuleError) as exc:
+        load_rules(str(folder))
+    assert f"{file}:" in str(exc.value) and said in str(exc.value), str(exc.value)

@@ -4,6 +4,8 @@ station's size (issue 17, item 2; docs/robustness.md)."""
 
 from __future__ import annotations
 
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -72,6 +74,41 @@ def test_a_release_delay_of_three_years_is_refused(tmp_path: Path, capsys: pytes
     assert code == Exit.BAD_INPUT
     assert f":{line}:{col}: error: signals.0.release_s: a release delay must be above 0 and up to 600 s" in err
     load_text(edit(JIAOPEI, (X_SIGNAL, X_SIGNAL.replace("}", ", release_s: 600}"))))  # the limit itself is fine
+
+
+HUGE = "1" + "0" * 400  # a whole number no float holds: OverflowError in the loader before (issue 45, item 6)
+MINIMAL_SB = "{id: SB, kind: boundary, at: 1200}"
+MINIMAL_TRACK = "{id: t-IG, from: J-1I, to: J-XI, section: IG}"
+
+
+@pytest.mark.parametrize(("old", "new", "needle", "said"), [
+    (MINIMAL_SB, f"{{id: SB, kind: boundary, at: {HUGE}}}", f"at: ^{HUGE}",
+     "ends.1.at: a position must be from -10000000 to 10000000 m"),
+    (MINIMAL_SB, f"{{id: SB, kind: boundary, at: -{HUGE}}}", f"at: ^-{HUGE}",
+     "ends.1.at: a position must be from -10000000 to 10000000 m"),
+    (MINIMAL_SB, f"{{id: SB, kind: boundary, at: K{HUGE}+100}}", f"at: ^K{HUGE}",
+     "ends.1.at: a position must be from -10000000 to 10000000 m"),
+    (MINIMAL_SB, f"{{id: SB, kind: boundary, at: K1+{HUGE}.5}}", f"at: ^K1+{HUGE}",
+     "ends.1.at: a position must be from -10000000 to 10000000 m"),
+    (MINIMAL_SB, "{id: SB, kind: boundary, at: K10001+0}", "at: ^K10001+0",
+     "ends.1.at: a position must be from -10000000 to 10000000 m"),
+    (MINIMAL_TRACK, f"{{id: t-IG, from: J-1I, to: J-XI, section: IG, length: {HUGE}}}", f"length: ^{HUGE}",
+     "tracks.4.length: a track's length must be above 0 and up to 200000 m"),
+    ("line_speed_kmh: 80", f"line_speed_kmh: {HUGE}", f"line_speed_kmh: ^{HUGE}",
+     "line_speed_kmh: a number this large is out of every range (beyond 1e308)"),
+], ids=["position", "negative", "km-post", "km-post-metres", "km-post-past-range", "track-length", "speed"])
+def test_check_refuses_a_number_too_large_for_a_float_without_a_traceback(
+        tmp_path: Path, old: str, new: str, needle: str, said: str) -> None:
+    """``liansuo check`` in a process of its own, as a user runs it, on a copy of the minimal example station."""
+    text = edit(MINIMAL, (old, new))
+    path = write(tmp_path, text)
+    proc = subprocess.run([sys.executable, "-m", "liansuo", "check", str(path)], capture_output=True, text=True,
+                          check=False, timeout=120)
+    line, col = position(text, needle)
+    first = proc.stderr.splitlines()[0]
+    assert proc.returncode == Exit.BAD_INPUT, proc.stderr
+    assert first.startswith(f"{path}:{line}:{col}: error: {said}"), proc.stderr
+    assert "    hint: " in proc.stderr and "Traceback" not in proc.stderr
 
 
 @pytest.mark.parametrize(("old", "new", "said"), [

@@ -11,9 +11,8 @@ instructor's panel is closed.
 
 from __future__ import annotations
 
-import shlex
-
 from liansuo.interlocking.io import Result
+from liansuo.simulation.language import command_name
 
 # The commands of a CBI operator console (操作表示机), as the command language names them.
 OPERATOR_COMMANDS = frozenset({
@@ -27,13 +26,10 @@ INSTRUCTOR = "instructor"
 
 
 def command_word(line: str) -> str:
-    """The command a line names ('' for an empty line or a comment)."""
-    text = line.split("#", 1)[0].strip()
-    try:
-        words = shlex.split(text)
-    except ValueError:
-        words = text.split()
-    return words[0] if words else ""
+    """The command a line names, read by the command language's own parser (quotes, backslashes and comments as the
+    language reads them: ``'run' 60s`` names ``run``); '' for an empty line, a comment, or a line the language
+    refuses unread (an unclosed quote, a line too long), which then reaches no command."""
+    return command_name(line)
 
 
 def refusal(role: str, line: str) -> Result | None:

@@ -33,7 +33,7 @@ class Aspects(BaseModel):
     diverging: list[Aspect]  # the aspects that tell a diverging route
     flashing: list[Aspect]  # aspects shown with the signal's flasher energised
     flasher_lamp: str  # the lamp the flasher makes flash
-    rank: dict[str, Annotated[int, Field(ge=0)]]  # how permissive (0: stop)
+    rank: dict[str, Annotated[int, Field(ge=0, le=1000)]]  # how permissive (0: stop)
     rear: dict[str, str]  # straight path: the most a signal shows in rear of one showing this (else: caution)
     automatic_block: list[Aspect] = Field(min_length=2)  # departure aspect by clear block sections ahead
     semi_auto_departure: Aspect  # departure onto a semi-automatic (64D) line accepted by the neighbour

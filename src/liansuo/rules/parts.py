@@ -14,8 +14,15 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from liansuo.rules.reader import Loc
 
-Seconds = Annotated[float, Field(gt=0)]
-Metres = Annotated[float, Field(gt=0)]
+# Every number of a rule file has a range (docs/rules.md), as the station file's have (stations/limits.py, a layer
+# above): what a railway has, widened to what a simulation can still wait for and compute.
+Seconds = Annotated[float, Field(gt=0, le=600)]  # a timer: the rules' longest is 3 min; verify waits each out
+Metres = Annotated[float, Field(gt=0, le=200_000)]  # within a station (stations/limits.py EXTENT)
+Speed = Annotated[float, Field(gt=0, le=400)]  # km/h: the fastest Chinese lines run at 350
+Gradient = Annotated[float, Field(ge=0, le=60)]  # per mille, as a station file's profile
+Count = Annotated[int, Field(ge=1, le=10_000)]  # sections in rear, turnouts driven at once
+TurnoutNumber = Annotated[int, Field(ge=1, le=62)]  # as a station file's turnout numbers (6 to 62)
+Force = Annotated[float, Field(gt=0, le=100_000)]  # N: as the switching-resistance fault's range
 
 
 class Part(BaseModel):
@@ -25,8 +32,8 @@ class Part(BaseModel):
 class ApproachLocking(Part):
     """How far in rear of a signal its approach (接近区段) reaches."""
 
-    home: dict[str, Annotated[int, Field(ge=1)]]  # line kind in rear (automatic, 64d, none) -> block sections
-    other: Annotated[int, Field(ge=1)]  # track sections in rear of every other signal
+    home: dict[str, Count]  # line kind in rear (automatic, 64d, none) -> block sections
+    other: Count  # track sections in rear of every other signal
 
 
 class InterlockingRules(Part):
@@ -34,15 +41,15 @@ class InterlockingRules(Part):
 
     release_s: dict[str, Seconds]  # manual time release, by route kind (train, shunt)
     section_fault_release_s: Seconds
-    overlap_gradient_per_mille: Annotated[float, Field(ge=0)]  # an approach falling more steeply calls for an overlap
+    overlap_gradient_per_mille: Gradient  # an approach falling more steeply calls for an overlap
     # the braking distance within which the approach to a home signal is looked at: line speed (km/h, up to) -> m
-    braking_distance_m: dict[Annotated[int, Field(gt=0)], Metres] = Field(min_length=1)
+    braking_distance_m: dict[Annotated[int, Field(gt=0, le=400)], Metres] = Field(min_length=1)
     overlap_release_s: Seconds  # for an overlap whose station file gives no release_s of its own
     squeeze_alarm_s: Seconds
-    turnout_concurrency: Annotated[int, Field(ge=1)]
+    turnout_concurrency: Count
     turnout_timeout_s: Seconds
     block_pulse_s: Seconds
-    usu_min_diverging_kmh: Annotated[float, Field(gt=0)]  # USU only over turnouts that allow this diverging speed
+    usu_min_diverging_kmh: Speed  # USU only over turnouts that allow this diverging speed
     guide_close_s: Seconds
     approach_locking: ApproachLocking
     enemy_onto_track: list[tuple[Literal["train", "shunt"], Literal["train", "shunt"]]]
@@ -62,7 +69,7 @@ class InterlockingRules(Part):
 class DrivingRules(Part):
     """What drivers do with what they see."""
 
-    aspect_speed_kmh: dict[str, Annotated[float, Field(gt=0)] | None]  # aspect -> speed past it (None: line speed)
+    aspect_speed_kmh: dict[str, Speed | None]  # aspect -> speed past it (None: line speed)
     stop_margin_m: Metres
     shunt_margin_m: Metres
     buffer_margin_m: Metres
@@ -82,8 +89,8 @@ class DesignRules(Part):
     fouling_clearance_emu_m: Metres
     cab_code_min_time_s: Seconds
     cab_code_margin_m: Metres
-    coding_speed_kmh: Annotated[float, Field(gt=0)]
-    diverging_speed_kmh: dict[Annotated[int, Field(ge=1)], Annotated[float, Field(gt=0)]] = Field(min_length=1)
+    coding_speed_kmh: Speed
+    diverging_speed_kmh: dict[TurnoutNumber, Speed] = Field(min_length=1)
     tuning_area_m: Metres
     tuning_area_tolerance_m: Metres
     tuning_dead_zone_max_m: Metres
@@ -98,8 +105,8 @@ class DesignRules(Part):
 
 class MachineSpec(Part):
     throw_s: Seconds
-    rated_force_N: Annotated[float, Field(gt=0)]
-    nominal_resistance_N: Annotated[float, Field(gt=0)]
+    rated_force_N: Force
+    nominal_resistance_N: Force
 
 
 class DoorSpec(Part):
@@ -111,5 +118,5 @@ class Equipment(Part):
     """Trackside equipment figures."""
 
     machines: dict[str, MachineSpec]  # by switch machine type (ZD6, ZDJ9, S700K as station files name them)
-    obstruction_lock_mm: Annotated[float, Field(gt=0)]
+    obstruction_lock_mm: Annotated[float, Field(gt=0, le=200)]
     doors: DoorSpec

@@ -83,7 +83,10 @@ def _describe(err: Any) -> str:
         return f"missing key '{where}'"
     value = err.get("input")
     shown = repr(value) if not isinstance(value, dict | list) else type(value).__name__
-    return f"{where}: {err['msg']} (got {shown[:40]})"
+    msg = err["msg"]
+    if err["type"] in ("finite_number", "float_type") and type(value) is int:  # past 1e308: no float holds it
+        msg = "a number this large is out of every range (beyond 1e308)"
+    return f"{where}: {msg} (got {shown[:40]})"
 
 
 def validate(model: type[M], rf: RuleFile) -> M:

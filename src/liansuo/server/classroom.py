@@ -18,7 +18,7 @@ from typing import Any
 from liansuo.classroom.assessment import Assessment, ExerciseSetupError
 from liansuo.classroom.exercise import DIFFICULTIES, bundled_exercises, parse_exercise
 from liansuo.classroom.report import write_report
-from liansuo.classroom.roles import INSTRUCTOR, refusal
+from liansuo.classroom.roles import INSTRUCTOR, command_word, refusal
 from liansuo.classroom.snapshot import EventCursor, snapshot
 from liansuo.interlocking.io import Result
 from liansuo.kit.source import StationError
@@ -158,7 +158,7 @@ class Classroom:
         nothing; ``run`` is the server's clock, never a client's."""
         s = self.seat(seat)
         no = refusal(role, line)
-        if no is None and line.split("#", 1)[0].split()[:1] == ["run"]:
+        if no is None and command_word(line) == "run":  # as the language reads it: 'run' 60s is run too
             no = Result.refuse("the classroom's clock runs on the server: pause, run or change its speed instead")
         result = no if no is not None else s.sim.command(line)
         if role != INSTRUCTOR and not result.ok:

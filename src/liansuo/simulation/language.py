@@ -12,7 +12,6 @@ written for a :class:`~simulation.world.World` serves any world built on it, suc
 from __future__ import annotations
 
 import re
-import shlex
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
 from typing import Generic, TypeVar
@@ -20,6 +19,7 @@ from typing import Generic, TypeVar
 from liansuo.interlocking.io import Result
 from liansuo.kit.source import Diagnostic, Source
 from liansuo.simulation.unknown import UnknownId
+from liansuo.simulation.words import split as shell_split
 
 W = TypeVar("W")
 W_contra = TypeVar("W_contra", contravariant=True)
@@ -27,13 +27,46 @@ _PLAIN = re.compile(r"[^'\"\\]*")  # no quote and no backslash: shlex would only
 _GAPS = re.compile(r"[ \t\r\n]+")  # shlex's whitespace (not every Unicode space: an ideographic space is a word)
 
 
+# The longest command line the language reads: a route with all its variant buttons or an expect line listing a
+# station's relays is some hundreds of characters; a recording keeps each line whole (simulation/recording).
+MAX_LINE_CHARS = 10_000
+
+
 def split_words(text: str) -> list[str]:
     """The words of a command line as :func:`shlex.split` gives them (quotes group, a backslash escapes;
-    ``ValueError`` for an unclosed quote). A line with no quote or backslash, nearly every line, is split without
-    the tokenizer: verify sends hundreds of thousands."""
+    ``ValueError`` for an unclosed quote), in time linear in its length (:mod:`.words`). A line with no quote or
+    backslash, nearly every line, is split on its whitespace alone: verify sends hundreds of thousands."""
     if _PLAIN.fullmatch(text):
         return [w for w in _GAPS.split(text) if w]
-    return shlex.split(text)
+    return shell_split(text)
+
+
+def parse_line(line: str) -> list[str]:
+    """The words of one command line as the language reads it, the command's name first: a ``#`` starts a comment,
+    quotes group and a backslash escapes as in a POSIX shell; ``[]`` for an empty line. ``ValueError`` with the
+    refusal's words for a line past :data:`MAX_LINE_CHARS` or one that cannot be split (an unclosed quote). Every
+    reader of a command line's name (the role filter, the classroom's clock) uses this, so that none reads a word
+    the language would read otherwise."""
+    if len(line) > MAX_LINE_CHARS:
+        raise ValueError(f"a command line has at most {MAX_LINE_CHARS:,} characters, and this one has more: send "
+                         "it as several commands")
+    text = line.split("#", 1)[0].strip()
+    if not text:
+        return []
+    try:
+        return split_words(text)
+    except ValueError as exc:
+        raise ValueError(f"cannot read the command: {exc}") from None
+
+
+def command_name(line: str) -> str:
+    """The command a line names as the language reads it; '' for an empty line, a comment, or a line the language
+    refuses before reading a name (too long, an unclosed quote)."""
+    try:
+        found = parse_line(line)
+    except ValueError:
+        return ""
+    return found[0] if found else ""
 
 
 @dataclass(frozen=True)
@@ -69,13 +102,12 @@ class Language(Generic[W]):
     def execute(self, world: W, line: str) -> Result:
         """Run one line (a ``#`` starts a comment); an unknown command is refused with the list of commands, and a
         command naming an element the station does not have with the closest ids."""
-        text = line.split("#", 1)[0].strip()
-        if not text:
-            return Result.accept("")
         try:
-            words = split_words(text)
+            words = parse_line(line)
         except ValueError as exc:
-            return Result.refuse(f"cannot read the command: {exc}")
+            return Result.refuse(str(exc))
+        if not words:
+            return Result.accept("")
         c = self._commands.get(words[0])
         if c is None:
             return Result.refuse(f"unknown command '{words[0]}'; commands: {', '.join(sorted(self._commands))}")
@@ -96,9 +128,9 @@ class Language(Generic[W]):
             if not isinstance(s, str):
                 errors.append(src.diagnostic(at, "a step is one command as text", "quote it if it contains ':'"))
                 continue
-            word = s.split("#", 1)[0].split()[:1]
-            if word and word[0] not in self._commands:
-                errors.append(src.diagnostic(at, f"unknown command '{word[0]}'",
+            word = command_name(s)  # a step the language cannot read is refused when it runs, as a console line
+            if word and word not in self._commands:
+                errors.append(src.diagnostic(at, f"unknown command '{word}'",
                                              f"commands: {', '.join(sorted(self._commands))}"))
             steps.append((s, src.mark(at).line))
         return steps

@@ -50,7 +50,10 @@ class Limit:
         the value as the user wrote it, by default ``value``)."""
         if self.holds(value):
             return ""
-        return f"{name} must be {self.range_text()}, not '{shown if shown is not None else f'{value:g}'}'"
+        text = shown if shown is not None else f"{value:g}"
+        if len(text) > 40:  # a number of 400 digits
+            text = f"{text[:37]}..."
+        return f"{name} must be {self.range_text()}, not '{text}'"
 
     def field(self, **extra: Any) -> Any:
         """The range in a JSON Schema (what editors check), for a pydantic model's field; :meth:`check` validates."""

@@ -50,6 +50,8 @@ def _describe(err: Any) -> str:
     if msg.startswith("Value error, "):
         msg = msg[len("Value error, "):]
     value = err.get("input")
+    if kind in ("finite_number", "float_type") and type(value) is int:  # a whole number past 1e308 has no float
+        msg = "a number this large is out of every range (beyond 1e308)"
     shown = repr(value) if not isinstance(value, dict | list) else type(value).__name__
     if len(shown) > 40:
         shown = shown[:37] + "..."

@@ -44,11 +44,25 @@ Id = Annotated[str, BeforeValidator(to_id), AfterValidator(_check_id), WithJsonS
 
 
 def parse_km(text: str) -> float:
-    """``K12+345.6`` -> 12345.6 metres."""
+    """``K12+345.6`` -> 12345.6 metres; ``ValueError`` for another text or a post outside the range of a position
+    (:data:`.limits.POSITION`), however many digits it has."""
     m = _KM_RE.fullmatch(text.strip())
     if not m:
         raise ValueError(f"'{text}' is not a position: write metres (e.g. 350.5) or a kilometre post (K12+345.6)")
-    return int(m.group(1)) * 1000 + float(m.group(2))
+    # float() of digits never overflows (it gives inf), where int() of them would, and past 4300 digits refuses
+    metres = float(m.group(1)) * 1000 + float(m.group(2))
+    if not limits.POSITION.holds(metres):
+        raise ValueError(f"{limits.POSITION.what} must be {limits.POSITION.range_text()}")
+    return metres
+
+
+def whole_as_float(value: int, limit: limits.Limit) -> float:
+    """A whole number read from a file as a float; one too large for a float (a position of 400 digits) is out of
+    ``limit``'s range, refused with its words instead of an ``OverflowError``."""
+    try:
+        return float(value)
+    except OverflowError:
+        raise ValueError(f"{limit.what} must be {limit.range_text()}") from None
 
 
 def _position(value: object) -> object:
@@ -57,7 +71,7 @@ def _position(value: object) -> object:
     if isinstance(value, str):
         return parse_km(value)
     if isinstance(value, int):
-        return float(value)
+        return whole_as_float(value, limits.POSITION)
     return value
 
 
@@ -67,17 +81,25 @@ Position = Annotated[float, BeforeValidator(_position), limits.POSITION.check(),
     {"anyOf": [{"type": "number", "minimum": limits.POSITION.low, "maximum": limits.POSITION.high},
                {"type": "string", "pattern": _KM_RE.pattern}],
      "description": "metres (down direction increasing) or a kilometre post such as K12+345.6"})]
-Metres = Annotated[float, Field(gt=0), BeforeValidator(lambda v: float(v) if type(v) is int else v)]
-TrackLength = Annotated[Metres, limits.TRACK_LENGTH.field(), limits.TRACK_LENGTH.check()]
+
+
+def _metres(limit: limits.Limit) -> BeforeValidator:
+    return BeforeValidator(lambda v: whole_as_float(v, limit) if type(v) is int else v)
+
+
+Metres = Annotated[float, Field(gt=0)]
+TrackLength = Annotated[Metres, _metres(limits.TRACK_LENGTH), limits.TRACK_LENGTH.field(),
+                        limits.TRACK_LENGTH.check()]
 Speed = Annotated[float, limits.SPEED.field(), limits.SPEED.check()]
 Release = Annotated[float, limits.RELEASE.field(), limits.RELEASE.check()]
 Coordinate = Annotated[float, limits.DIAGRAM.field(), limits.DIAGRAM.check()]
-TuningArea = Annotated[Metres, limits.TUNING_AREA.field(), limits.TUNING_AREA.check()]
+TuningArea = Annotated[Metres, _metres(limits.TUNING_AREA), limits.TUNING_AREA.field(), limits.TUNING_AREA.check()]
 DeadZone = Annotated[float, limits.DEAD_ZONE.field(), limits.DEAD_ZONE.check()]
 Capacitance = Annotated[float, limits.CAPACITANCE.field(), limits.CAPACITANCE.check()]
 Stretch = Annotated[float, limits.STRETCH.field(), limits.STRETCH.check()]
 StopWindow = Annotated[float, limits.STOP_WINDOW.field(), limits.STOP_WINDOW.check()]
-SlipLength = Annotated[Metres, limits.DOUBLE_SLIP_LENGTH.field(), limits.DOUBLE_SLIP_LENGTH.check()]
+SlipLength = Annotated[Metres, _metres(limits.DOUBLE_SLIP_LENGTH),
+                     limits.DOUBLE_SLIP_LENGTH.field(), limits.DOUBLE_SLIP_LENGTH.check()]
 
 
 _ROUTE_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_\-/]*(\([A-Za-z0-9_\-/,]+\))?(\+[A-Za-z0-9_\-/]+)?(/D)?$")

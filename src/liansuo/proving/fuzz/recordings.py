@@ -5,10 +5,11 @@ The seeds are real recordings, made with the recorder (:mod:`~liansuo.simulation
 example scenarios (each ``run`` step shortened, so a replay stays quick) and from a console session with faults and
 refused commands. A sample is a seed with one to four damages of the kinds a disk, an editor or a hand makes: lines
 dropped, repeated, swapped or cut; a key removed; a value replaced by an extreme (NaN, infinity, -1, 0, 2**31, 1e308,
-text, null, nesting deeper than any parser goes, control characters); another station, a device or a folder as the
-station; bytes that are not UTF-8. :func:`attempt` gives it to the product as ``replay --verify`` does: load, find and
-check the station, re-simulate. A clear refusal (a :class:`~stations.source.StationError`, or mismatches found) is
-"refused"; anything escaping is a defect.
+text, null, nesting deeper than any parser goes, control characters); another station, a device, a folder or a
+file outside the recording's folder as the station, an empty or wrong digest; bytes that are not UTF-8.
+:func:`attempt` gives it to the product as ``replay --verify`` does: load, find and check the station, re-simulate.
+A clear refusal (a :class:`~stations.source.StationError`, or mismatches found) is "refused"; anything escaping is a
+defect.
 
 ``liansuo fuzz recordings --budget N`` runs the same generator longer; ``tests/test_fuzz_recordings.py`` runs it
 derandomized with a small budget.
@@ -49,7 +50,9 @@ DrawFn = Callable[[st.SearchStrategy[Any]], Any]
 EXTREMES: tuple[Any, ...] = (float("nan"), float("inf"), float("-inf"), -1, 0, 1, 0.0, 1e308, -1e308, 2**31, 2**63,
                              10**30, 1e9, 345_601, "", "x" * 5000, "\x1b[2J\x1b]0;owned\x07", "\u2028", "\x00", None,
                              True, [], {}, [[[]]], {"k": "cmd"})
-STATIONS = ("gaotie", "depot", "jiaopei", "/dev/zero", "/tmp", "../nowhere.yaml", "", "x" * 5000, "\x1b[2J", ".")
+STATIONS = ("gaotie", "depot", "jiaopei", "/dev/zero", "/tmp", "../nowhere.yaml", "", "x" * 5000, "\x1b[2J", ".",
+            "/etc/passwd", "../../../../etc/passwd", "sub/../../x.yaml")  # outside the recording's folder
+DIGESTS = ("", "0" * 64, "A" * 64, "x")  # empty: the station unchecked (issue 45)
 COMMAND_LINES = ("run 100h", "run 50min", "run 1s", "", "expect alarm nothing", "route X XI", "cancel X", "bogus",
                  "run 0s")
 
@@ -169,6 +172,8 @@ def _edit(draw: DrawFn, lines: list[bytes], line: int | None = None) -> list[byt
         del holder[last]
     elif last == "station":
         holder[last] = draw(st.sampled_from(STATIONS))
+    elif last == "station_sha256":
+        holder[last] = draw(st.sampled_from(DIGESTS))
     elif last == "line":
         holder[last] = draw(st.sampled_from(COMMAND_LINES))
     else:

@@ -46,10 +46,11 @@ VERIFY = frozenset({"minimal", "danxian"})  # verify runs in well under a second
 Draw = Callable[[st.SearchStrategy[Any]], Any]
 Place = tuple[str | int, ...]
 
-EXTREME_NUMBERS = (math.nan, math.inf, -math.inf, -1, 0, 1e-300, 1e308, -1e308, 2**31, 2**63, 1e9, 100_000_000)
+EXTREME_NUMBERS = (math.nan, math.inf, -math.inf, -1, 0, 1e-300, 1e308, -1e308, 2**31, 2**63, 1e9, 100_000_000,
+                   10**400, -10**400)  # 400 digits: no float holds them
 ALIEN_VALUES: tuple[Any, ...] = (None, True, "text", 12, 1.5, [], {}, [1, 2], {"a": 1}, "K12+345.6")
 TEXTS = ("", "X" * 65, "X" * 5000, "\x1b]0;pwned\x07\x1b[2J", "名" * 40, "NOSUCH", "X-NOSUCH", "a b", "X\n",
-         "X-XI(NOSUCH)", "1/3/5", "-", "K1+2")
+         "X-XI(NOSUCH)", "1/3/5", "-", "K1+2", f"K{10**400}+0", f"K1+{10**400}.5")
 _RAW_CONTROL = re.compile(r"[\x00-\x08\x0b-\x1f\x7f-\x9f]")
 _DIAGNOSTIC = re.compile(r"^(.+):(\d+):(\d+): error: .+")
 
@@ -117,7 +118,8 @@ def _extreme(draw: Draw, data: Any) -> str:
     if path is None:
         return "no number"
     old = _get(data, path)
-    new = draw(st.sampled_from((*EXTREME_NUMBERS, -old, old * 1000, old + 0.001, old + 1, old - 1, old * 1.5)))
+    near = (-old, old * 1000, old + 0.001, old + 1, old - 1, old * 1.5) if abs(old) < 1e300 else ()
+    new = draw(st.sampled_from((*EXTREME_NUMBERS, *near)))
     _set(data, path, new)
     return f"{path} = {new!r}"
 

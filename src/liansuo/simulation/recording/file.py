@@ -321,7 +321,18 @@ def station_file(rec: Recording, given: str | None = None) -> Path:
     if found is not None:
         return found
     path = Path(name)
-    return path if given is not None or path.is_absolute() else Path(rec.path).parent / path
+    if given is not None:
+        return path
+    folder = Path(rec.path).parent
+    target = folder / path
+    # a recording is a file one is given: its header may name only a station beside it, never /etc/shadow or ../..,
+    # whose lines a refusal would echo. The station is not read here: nothing of the file named is shown.
+    if path.is_absolute() or not target.resolve().is_relative_to(folder.resolve()):
+        raise _error(rec.path, 1, f"the recording names its station as {printable(name)}, outside the recording's "
+                                  "folder: a recording's station is a bundled name or a file in its folder",
+                     f"if it is the station it was made on, give it: 'liansuo replay FILE --station "
+                     f"{printable(str(target))}'")
+    return target
 
 
 def recording_station(rec: Recording, given: str | None = None) -> Station:
@@ -346,7 +357,7 @@ def recording_station(rec: Recording, given: str | None = None) -> Station:
         raise _error(rec.path, 1, f"{made_on}, but {found} is station {printable(station.id)}: a replay there cannot "
                                   "reproduce it", fix)
     digest = station_digest(path)
-    if rec.header.station_sha256 and digest != rec.header.station_sha256:
+    if digest != rec.header.station_sha256:
         raise _error(rec.path, 1, f"{made_on}, and the file of {found} has changed since (its SHA-256 differs): a "
                                   "replay on it could not reproduce the recording",
                      "give the station file as it was with 'liansuo replay FILE --station FILE', or record again")

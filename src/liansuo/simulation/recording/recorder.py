@@ -30,7 +30,7 @@ from typing import IO, Any
 
 from liansuo.interlocking.io import Result
 from liansuo.simulation.recording.file import Recording, RecordingError, load_recording, station_reference
-from liansuo.simulation.recording.schema import FORMAT, VERSION
+from liansuo.simulation.recording.schema import FORMAT, MAX_COMMAND_CHARS, VERSION
 from liansuo.simulation.sim import Simulation
 
 Record = dict[str, Any]
@@ -91,6 +91,9 @@ class Recorder:
 
     def header(self) -> None:
         station, digest = station_reference(self.sim.station, self.path)
+        if not digest:  # the replay checks the station by this digest: a recording without one is refused
+            raise ValueError(f"station {self.sim.station.id} was not read from a file: a recording names its station's "
+                             "file and its SHA-256; load the station from a file to record it")
         self.write({"k": "header", "format": FORMAT, "version": VERSION, "station": station,
                     "station_id": self.sim.station.id, "station_sha256": digest,
                     "cycle_s": self.sim.cycle_s, "t0": self.sim.t})
@@ -155,7 +158,7 @@ class Recorder:
                 self.write(record)
 
     def _command_done(self, n: int, t: float, line: str, result: Result) -> None:
-        self.write({"k": "cmd", "i": self.commands, "n": n, "t": t, "line": line, "ok": result.ok,
+        self.write({"k": "cmd", "i": self.commands, "n": n, "t": t, "line": line[:MAX_COMMAND_CHARS], "ok": result.ok,
                     "msg": result.message, "by": self.source})
 
     def _command_changes(self, changes: State) -> None:

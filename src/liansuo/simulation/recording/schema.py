@@ -11,9 +11,10 @@ from __future__ import annotations
 
 from typing import Annotated, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, TypeAdapter
+from pydantic import BaseModel, ConfigDict, Field, TypeAdapter, field_validator
 
 from liansuo.kit.filekind import RECORDING_FORMAT
+from liansuo.simulation.language import MAX_LINE_CHARS as MAX_LINE_CHARS_OF_A_COMMAND
 
 FORMAT = RECORDING_FORMAT  # the header's "format": how kit/filekind.py tells a recording from other files
 VERSION = 2  # 2: the station's digest, its path relative to the recording, commands numbered (cmd "i", end "cmds")
@@ -34,8 +35,9 @@ MAX_LINE_CHARS = 8 * 1024 * 1024
 MAX_STATION_CHARS = 4096
 # An element id, an aspect or a state in a record; a station's ids are far shorter.
 MAX_ID_CHARS = 200
-# A command line and its answer, as the console's command bar or a script sends them.
-MAX_COMMAND_CHARS = 10_000
+# A command line and its answer, as the console's command bar or a script sends them: a line past the language's
+# limit is recorded cut one character past it, which the language refuses in the same words on replay.
+MAX_COMMAND_CHARS = MAX_LINE_CHARS_OF_A_COMMAND + 1
 MAX_ANSWER_CHARS = 100_000
 # Diagnostics listed for one file before the rest are left out.
 MAX_ERRORS = 20
@@ -81,10 +83,19 @@ class HeaderRecord(_Record):
     station: str = Field(min_length=1, max_length=MAX_STATION_CHARS,
                          description="a bundled station name, or the station file's path relative to the recording")
     station_id: Id = Field(description="the station's id, compared with the station replayed on")
-    station_sha256: str = Field(pattern=r"^([0-9a-f]{64})?$",
-                                description="SHA-256 of the station file ('' for a station not read from a file)")
+    station_sha256: str = Field(pattern=r"^[0-9a-f]{64}$",
+                                description="SHA-256 of the station file, compared with the station replayed on")
     cycle_s: float = Field(ge=MIN_CYCLE_S, le=MAX_CYCLE_S, description="the interlocking's cycle, seconds")
     t0: Time = Field(description="simulated time when the recording started")
+
+
+    @field_validator("station_sha256", mode="before")
+    @classmethod
+    def _digest_given(cls, value: object) -> object:
+        if value == "":  # an empty digest would let any file of the station's id stand in for it
+            raise ValueError("station_sha256 is empty: a recording carries the SHA-256 of its station's file, which "
+                             "the replay checks; record the session again")
+        return value
 
 
 class InitRecord(_Record):
