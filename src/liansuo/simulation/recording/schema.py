@@ -88,7 +88,6 @@ class HeaderRecord(_Record):
     cycle_s: float = Field(ge=MIN_CYCLE_S, le=MAX_CYCLE_S, description="the interlocking's cycle, seconds")
     t0: Time = Field(description="simulated time when the recording started")
 
-
     @field_validator("station_sha256", mode="before")
     @classmethod
     def _digest_given(cls, value: object) -> object:
