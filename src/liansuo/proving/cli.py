@@ -19,7 +19,7 @@ from liansuo.kit.exitcodes import Exit, bad_input, refuse
 from liansuo.kit.fit import fit_all
 from liansuo.kit.jsonreport import print_report
 from liansuo.kit.plotfiles import add_plot_options, plot_problem, write_rows
-from liansuo.kit.source import StationError
+from liansuo.kit.source import Diagnostic, StationError
 from liansuo.proving.junit import write_junit
 from liansuo.proving.scenario import ScenarioLog, parse_scenario, run_scenario, station_of
 from liansuo.proving.scripts import Outcome, Script, Unrunnable, parse_script, run_script, script_station, selected
@@ -36,20 +36,23 @@ FORMATS = ("text", "json")
 
 
 def _load_scripts(files: list[str]) -> tuple[list[tuple[Script, Station]], list[Unrunnable], int]:
-    """Every script with its station; those that did not load (each reported on stderr) and the exit status."""
+    """Every script with its station; those that did not load (all reported at once on stderr, or as one JSON error
+    object) and the exit status."""
     scripts: list[tuple[Script, Station]] = []
     unrunnable: list[Unrunnable] = []
-    status = 0
+    found: list[Diagnostic] = []
+    what = "test script"
     for f in files:
-        what = "test script"
+        kind = "test script"
         try:
             script = parse_script(Path(f))
-            what = f"station of {f}"
+            kind = f"station of {f}"
             scripts.append((script, script_station(script)))
         except StationError as exc:
-            status = bad_input(exc, what)
+            found += exc.diagnostics
+            what = f"input of {len(unrunnable) + 1} scripts" if unrunnable else kind
             unrunnable.append(Unrunnable(f, [str(d) for d in exc.diagnostics]))
-    return scripts, unrunnable, status
+    return scripts, unrunnable, bad_input(StationError(found), what) if found else 0
 
 
 def cmd_test(args: argparse.Namespace) -> int:
