@@ -136,7 +136,7 @@ def test_zpw_spells_csv_as_table_does(tmp_path: Path, capsys: pytest.CaptureFixt
 def test_nothing_selected_is_5_with_a_message(capsys: pytest.CaptureFixture[str]) -> None:
     code, out, err = run(capsys, "test", "-k", "zzz", str(SCRIPT))
     assert code == 5 and out == ""
-    assert err == "liansuo test: no test name contains 'zzz' (of 17 tests in 1 script); nothing ran\n"
+    assert err == "liansuo test: no test matches -k 'zzz' (of 17 tests in 1 script); nothing ran\n"
     code, out, err = run(capsys, "verify", "jiaopei", "--route", "NOPE", "--no-pairs")
     assert code == 5 and out == ""
     assert err.startswith("liansuo verify: no route NOPE in jiaopei") and len(err.splitlines()) == 1

@@ -31,9 +31,11 @@ def run(tmp_path: Path, *scripts: str, extra: tuple[str, ...] = ()) -> tuple[int
 
 
 def test_a_passing_run_is_valid_with_times_timestamp_and_hostname(
-        tmp_path: Path, schema: xmlschema.XMLSchema, capsys: pytest.CaptureFixture[str]) -> None:
+        tmp_path: Path, schema: xmlschema.XMLSchema, capsys: pytest.CaptureFixture[str],
+        monkeypatch: pytest.MonkeyPatch) -> None:
     before = datetime.now().replace(microsecond=0)
-    script = str(EXAMPLE / "jiaopei-interlocking-test.yaml")
+    monkeypatch.chdir(EXAMPLE.parent)
+    script = "scripts/jiaopei-interlocking-test.yaml"
     status, suite = run(tmp_path, script, extra=("-k", "guide signal"))
     assert status == 0
     schema.validate(tmp_path / "report.xml")
@@ -44,7 +46,7 @@ def test_a_passing_run_is_valid_with_times_timestamp_and_hostname(
     stamp = datetime.fromisoformat(suite.get("timestamp", ""))
     assert before <= stamp <= datetime.now()
     [case] = suite.findall("testcase")
-    assert case.get("classname") == script and "guide signal" in case.get("name", "")
+    assert case.get("classname") == "scripts.jiaopei-interlocking-test" and "guide signal" in case.get("name", "")
     assert float(case.get("time", "")) >= 0 and float(suite.get("time", "")) >= float(case.get("time", ""))
     assert not list(case)  # passed: no failure, no error
     assert "1 passed, 0 failed" in capsys.readouterr().out

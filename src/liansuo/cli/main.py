@@ -11,6 +11,8 @@ import argparse
 import sys
 from collections.abc import Callable, Sequence
 from functools import partial
+from itertools import pairwise
+from typing import NoReturn
 
 from liansuo.bench import cli as bench
 from liansuo.circuits.phase25 import cli as phase25cli
@@ -21,7 +23,7 @@ from liansuo.fieldio import cli as fieldcli
 from liansuo.interlocking.table import cli as interlocking
 from liansuo.kit.exitcodes import Exit, refuse
 from liansuo.kit.extras import needed
-from liansuo.kit.jsonreport import version
+from liansuo.kit.jsonreport import errors_as_json, print_error, version
 from liansuo.proving import cli as proving
 from liansuo.proving.explore import cli as explore
 from liansuo.proving.fuzz import cli as fuzz
@@ -76,8 +78,24 @@ def extra_of(args: argparse.Namespace) -> str | None:
     return NEEDS.get(getattr(args, "command", None) or "")
 
 
+class Parser(argparse.ArgumentParser):
+    """argparse's parser, whose refusal of a command line with ``--format json`` is also a JSON error object on
+    stdout (exit status 2, as argparse's own)."""
+
+    def error(self, message: str) -> NoReturn:
+        print_error(Exit.USAGE, f"{message}; '{self.prog} --help' lists the arguments")
+        super().error(message)
+
+
+def json_asked(argv: Sequence[str]) -> str | None:
+    """The command of a command line that asks for ``--format json`` (its errors then go out as JSON too)."""
+    words = list(argv)
+    asked = "--format=json" in words or any(a == "--format" and b == "json" for a, b in pairwise(words))
+    return next((w for w in words if not w.startswith("-")), None) if asked else None
+
+
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="liansuo", description="Station signalling and interlocking simulator (联锁)")
+    p = Parser(prog="liansuo", description="Station signalling and interlocking simulator (联锁)")
     p.add_argument("--version", action="version", version=f"liansuo {version()}")
     sub = p.add_subparsers(dest="command", metavar="COMMAND")
 
@@ -94,18 +112,22 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
-    args = parser.parse_args(argv)
+    words = sys.argv[1:] if argv is None else list(argv)
+    with errors_as_json(json_asked(words)):
+        args = parser.parse_args(words)
     handler: Handler | None = getattr(args, "handler", None)
     if handler is None:
         parser.print_help()
         print("liansuo: a COMMAND is needed (the list above)", file=sys.stderr)
         return 2
-    extra = extra_of(args)
-    why = needed(extra) if extra else None
-    if why:
-        return refuse(args.command, why, Exit.USAGE)
+    json_errors = args.command if getattr(args, "format", None) == "json" else None
     try:
-        return handler(args)
+        with errors_as_json(json_errors):  # its refusals as a JSON error object too (kit/jsonreport.py)
+            extra = extra_of(args)
+            why = needed(extra) if extra else None
+            if why:
+                return refuse(args.command, why, Exit.USAGE)
+            return handler(args)
     except BrokenPipeError:  # e.g. piped into head
         return 0
     except KeyboardInterrupt:

@@ -1,6 +1,8 @@
 """The exit status of every ``liansuo`` command, by pytest's convention (docs/commands.md, "Exit status").
 
-Each non-zero status comes with a one-line message on stderr that says what went wrong and what to do.
+Each non-zero status comes with a one-line message on stderr that says what went wrong and what to do; with
+``--format json``, an error object on stdout too (:func:`~liansuo.kit.jsonreport.print_error`) unless the command's
+report was printed already.
 """
 
 from __future__ import annotations
@@ -8,6 +10,7 @@ from __future__ import annotations
 import sys
 from enum import IntEnum
 
+from liansuo.kit.jsonreport import print_error
 from liansuo.kit.printable import printable
 from liansuo.kit.source import StationError
 
@@ -24,17 +27,24 @@ class Exit(IntEnum):
 
 def refuse(command: str, message: str, status: Exit) -> int:
     """Print ``liansuo COMMAND: MESSAGE`` on stderr, one line (control characters a message may quote from a file
-    written out), and give ``status`` back for the command to return."""
+    written out), and with ``--format json`` the error object on stdout; give ``status`` back for the command to
+    return."""
     print(f"liansuo {command}: {printable(message)}", file=sys.stderr)
+    print_error(status, message)
     return int(status)
 
 
-def bad_input(exc: StationError, what: str = "station") -> int:
+def bad_input(exc: StationError, what: str = "station", **keys: object) -> int:
     """Every diagnostic of a file that did not load on stderr (``FILE:LINE:COLUMN: error: ...``), then, unless that
-    was one line already, ``N errors; the WHAT was not loaded``; :attr:`Exit.BAD_INPUT`."""
+    was one line already, ``N errors; the WHAT was not loaded``; with ``--format json`` the error object on stdout,
+    every diagnostic in its ``errors`` and ``keys`` beside them; :attr:`Exit.BAD_INPUT`."""
     for d in exc.diagnostics:
         print(d, file=sys.stderr)
     n = len(exc.diagnostics)
     if n != 1 or exc.diagnostics[0].hint:
         print(f"{n} error{'s' if n != 1 else ''}; the {what} was not loaded", file=sys.stderr)
+    first = exc.diagnostics[0].message if exc.diagnostics else "it could not be read"
+    more = f" (and {n - 1} more error{'s' if n != 2 else ''})" if n > 1 else ""
+    print_error(Exit.BAD_INPUT, f"{first}{more}; the {what} was not loaded",
+                [d.as_dict() for d in exc.diagnostics], **keys)
     return int(Exit.BAD_INPUT)

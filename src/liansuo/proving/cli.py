@@ -1,4 +1,4 @@
-"""``liansuo test FILE... [-k TEXT] [-v] [--format text|json] [--junit-xml FILE]``: run YAML route-test scripts;
+"""``liansuo test FILE... [-k EXPRESSION] [-v] [--format text|json] [--junit-xml FILE]``: run YAML route-test scripts;
 ``liansuo run SCENARIO [--until DURATION] [--engine kinematic|sumo] [--format text|json] [--plot FILE]
 [--plot-csv FILE]``: run a scenario headless (and plot its trains, :mod:`.trainplot`).
 
@@ -19,8 +19,9 @@ from liansuo.kit.exitcodes import Exit, bad_input, refuse
 from liansuo.kit.fit import fit_all
 from liansuo.kit.jsonreport import print_report
 from liansuo.kit.plotfiles import add_plot_options, plot_problem, write_rows
-from liansuo.kit.source import StationError
+from liansuo.kit.source import Diagnostic, StationError
 from liansuo.proving.junit import write_junit
+from liansuo.proving.keywords import expression
 from liansuo.proving.scenario import ScenarioLog, parse_scenario, run_scenario, station_of
 from liansuo.proving.scripts import Outcome, Script, Unrunnable, parse_script, run_script, script_station, selected
 from liansuo.proving.trainplot import COLUMNS as TRACE_COLUMNS
@@ -36,20 +37,23 @@ FORMATS = ("text", "json")
 
 
 def _load_scripts(files: list[str]) -> tuple[list[tuple[Script, Station]], list[Unrunnable], int]:
-    """Every script with its station; those that did not load (each reported on stderr) and the exit status."""
+    """Every script with its station; those that did not load (all reported at once on stderr, or as one JSON error
+    object) and the exit status."""
     scripts: list[tuple[Script, Station]] = []
     unrunnable: list[Unrunnable] = []
-    status = 0
+    found: list[Diagnostic] = []
+    what = "test script"
     for f in files:
-        what = "test script"
+        kind = "test script"
         try:
             script = parse_script(Path(f))
-            what = f"station of {f}"
+            kind = f"station of {f}"
             scripts.append((script, script_station(script)))
         except StationError as exc:
-            status = bad_input(exc, what)
+            found += exc.diagnostics
+            what = f"input of {len(unrunnable) + 1} scripts" if unrunnable else kind
             unrunnable.append(Unrunnable(f, [str(d) for d in exc.diagnostics]))
-    return scripts, unrunnable, status
+    return scripts, unrunnable, bad_input(StationError(found), what) if found else 0
 
 
 def cmd_test(args: argparse.Namespace) -> int:
@@ -63,7 +67,7 @@ def cmd_test(args: argparse.Namespace) -> int:
         return status
     if not any(selected(script, args.k) for script, _ in loaded):
         total = sum(len(script.tests) for script, _ in loaded)
-        return refuse("test", f"no test name contains {args.k!r} (of {total} test{'s' if total != 1 else ''} in "
+        return refuse("test", f"no test matches -k {args.k!r} (of {total} test{'s' if total != 1 else ''} in "
                       f"{len(loaded)} script{'s' if len(loaded) != 1 else ''}); nothing ran", Exit.NOTHING_SELECTED)
     outcomes: list[Outcome] = []
     for script, station in loaded:
@@ -161,7 +165,10 @@ def register_run(add: Add) -> None:
 def register(add: Add) -> None:
     sp = add("test", cmd_test, "run YAML route-test scripts")
     sp.add_argument("files", nargs="+", metavar="FILE", help="test script files")
-    sp.add_argument("-k", metavar="TEXT", help="run only tests whose name contains TEXT (exit status 5 if none does)")
+    sp.add_argument("-k", metavar="EXPRESSION", type=expression,
+                    help="run only the tests the expression selects, as pytest's -k: words of their names (any case; "
+                    "a word matches a part of the test's name or its file's), and, or, not, parentheses; exit status "
+                    "5 if none does")
     sp.add_argument("-v", "--verbose", action="store_true", help="print every step of failing tests")
     sp.add_argument("--format", choices=FORMATS, default="text", help="text (default) or json")
     sp.add_argument("--junit-xml", metavar="FILE", help="also write a JUnit XML report")

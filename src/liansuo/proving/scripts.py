@@ -25,8 +25,9 @@ from pathlib import Path
 
 from liansuo.interlocking.io import Result
 from liansuo.kit.filekind import read_source
-from liansuo.kit.source import Diagnostic, StationError
+from liansuo.kit.source import Diagnostic, Source, StationError
 from liansuo.proving.fileschemas import ScriptFile
+from liansuo.proving.keywords import Expression
 from liansuo.proving.oracle import Watch
 from liansuo.simulation.sim import LANGUAGE, Simulation
 from liansuo.stations.library import resolve_from
@@ -101,11 +102,29 @@ def parse_script(path: Path) -> Script:
     steps = [LANGUAGE.read_steps(src, ("tests", i, "steps"), t.get("steps") if isinstance(t, dict) else None, errors)
              for i, t in enumerate(tests_raw if isinstance(tests_raw, list) else [])]
     model = validate(src, ScriptFile, errors, "script", "'liansuo docs commands'")
+    if model is not None:
+        errors += _same_names(src, [t.name for t in model.tests])
     if errors or model is None:
         raise StationError(errors)
     tests = [ScriptTest(t.name, [Step(text, line) for text, line in lines], src.mark(("tests", i)).line)
              for i, (t, lines) in enumerate(zip(model.tests, steps, strict=True))]
     return Script(str(path), model.station, tests, model.cycle_ms / 1000.0, model.safety)
+
+
+def _same_names(src: Source, names: list[str]) -> list[Diagnostic]:
+    """A test whose name an earlier test of the script has: the JUnit report, pytest's node ids and ``-k`` tell
+    tests apart by name."""
+    first: dict[str, int] = {}
+    out = []
+    for i, name in enumerate(names):
+        if name in first:
+            line = src.mark(("tests", first[name], "name")).line
+            out.append(src.diagnostic(("tests", i, "name"), f"a second test named {name!r} (the first is on line "
+                                      f"{line})", "give each test of a script its own name: reports and -k tell "
+                                      "tests apart by it"))
+        else:
+            first[name] = i
+    return out
 
 
 def script_station(script: Script) -> Station:
@@ -115,8 +134,12 @@ def script_station(script: Script) -> Station:
 
 
 def selected(script: Script, only: str | None) -> list[ScriptTest]:
-    """The script's tests whose name contains ``only`` (case-insensitive); all of them without it."""
-    return [t for t in script.tests if not only or only.lower() in t.name.lower()]
+    """The script's tests that the ``-k`` expression ``only`` selects (:mod:`.keywords`: pytest's, on the test's name
+    and the script's file name); all of them without it."""
+    if not only:
+        return list(script.tests)
+    expr = Expression(only)
+    return [t for t in script.tests if expr.matches((t.name, Path(script.file).name))]
 
 
 def run_script(script: Script, only: str | None = None, station: Station | None = None) -> list[Outcome]:

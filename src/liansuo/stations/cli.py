@@ -43,14 +43,7 @@ def cmd_check(args: argparse.Namespace) -> int:
             if found:
                 raise StationError(found)
     except StationError as exc:
-        if args.format == "json":
-            print_report("check", False, {"station": args.station,
-                                          "errors": [d.as_dict() for d in exc.diagnostics]})
-            first = exc.diagnostics[0] if exc.diagnostics else None
-            return refuse("check", f"{first.file}:{first.line}:{first.column}: {first.message} (and "
-                          f"{len(exc.diagnostics) - 1} more); the station was not loaded" if first else
-                          "the station was not loaded", Exit.BAD_INPUT)
-        return bad_input(exc)
+        return bad_input(exc, station=args.station)
     for more in args.more_warnings:  # checks of the layers above, handed in by the command line (cli/main.py)
         station.warnings = [*station.warnings, *more(station)]
     wired = ""
@@ -58,9 +51,7 @@ def cmd_check(args: argparse.Namespace) -> int:
         found, wired = args.points_check(station, args.points)
         errors = [d for d in found if d.severity == "error"]
         if errors:
-            if args.format == "json":
-                print_report("check", False, {"station": args.station, "errors": [d.as_dict() for d in errors]})
-            return bad_input(StationError(errors), "point map")
+            return bad_input(StationError(errors), "point map", station=args.station)
         station.warnings = [*station.warnings, *found]
     if args.format == "json":
         print_report("check", True, {**summarise(station), **({"points": wired} if wired else {})})

@@ -19,7 +19,7 @@ from liansuo.kit.source import StationError
 from liansuo.proving.explore.actions import Bounds
 from liansuo.proving.explore.report import as_dict, as_text
 from liansuo.proving.explore.search import Expander, expand_here, expand_on, search
-from liansuo.proving.spread import SpreadError, client
+from liansuo.proving.spread import SpreadError, add_wait_option, client
 from liansuo.rules import load_rules
 from liansuo.stations.loader import load
 
@@ -39,7 +39,7 @@ def cmd_explore(args: argparse.Namespace) -> int:
     try:
         with ExitStack() as stack:
             if workers:
-                c = stack.enter_context(client(workers, args.scheduler))
+                c = stack.enter_context(client(workers, args.scheduler, args.cluster_wait))
                 expand = expand_on(c, (uuid.uuid4().hex, station, rules, bounds, reduce))
             else:
                 expand = expand_here(expander)
@@ -98,6 +98,7 @@ def register(add: Add) -> None:
     sp.add_argument("--workers", type=count, default=0, metavar="N",
                     help="spread each level over Dask on N local worker processes (default: this process)")
     sp.add_argument("--scheduler", metavar="ADDRESS", help="spread it over the Dask cluster at ADDRESS instead")
+    add_wait_option(sp)
     bounds = Bounds()
     sp.add_argument("--routes", type=count, default=bounds.routes, metavar="N",
                     help=f"routes set at once, guide aspects included (default {bounds.routes})")

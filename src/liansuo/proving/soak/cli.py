@@ -24,7 +24,7 @@ from liansuo.kit.jsonreport import print_report
 from liansuo.proving.oracle import Violation, Watch
 from liansuo.proving.progress import progress
 from liansuo.proving.soak.run import SoakRun, soak
-from liansuo.proving.spread import SpreadError, fan_out
+from liansuo.proving.spread import WAIT_S, SpreadError, add_wait_option, fan_out
 from liansuo.simulation.sim import Simulation
 
 Add = Callable[..., argparse.ArgumentParser]
@@ -126,7 +126,7 @@ def run_seed(shared: tuple[str, int], seed: int) -> dict[str, object]:
 
 
 def soak_runs(station: str, steps: int, seeds: list[int], *, workers: int = 0, scheduler: str | None = None,
-              show_progress: bool | None = False) -> list[dict[str, object]]:
+              show_progress: bool | None = False, cluster_wait_s: float = WAIT_S) -> list[dict[str, object]]:
     """The report of a run for each seed, in seed order: here one after the other, or on Dask."""
     from liansuo.stations.loader import load
 
@@ -139,7 +139,7 @@ def soak_runs(station: str, steps: int, seeds: list[int], *, workers: int = 0, s
                 advance(steps)
             return out
         return fan_out((station, steps), seeds, run_seed, workers=workers, scheduler=scheduler, advance=advance,
-                       size=lambda seed: steps)
+                       size=lambda seed: steps, wait_s=cluster_wait_s)
 
 
 def cmd_soak(args: argparse.Namespace) -> int:
@@ -151,7 +151,7 @@ def cmd_soak(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     try:
         reps = soak_runs(args.station, args.steps, seeds, workers=workers, scheduler=args.scheduler,
-                         show_progress=None)
+                         show_progress=None, cluster_wait_s=args.cluster_wait)
     except StationError as exc:
         return bad_input(exc)
     except SpreadError as exc:
@@ -219,4 +219,5 @@ def register(add: Add) -> None:
     sp.add_argument("--scheduler", metavar="ADDRESS",
                     help="run on the Dask cluster whose scheduler is at ADDRESS (tcp://host:8786); "
                          "'liansuo docs cluster'")
+    add_wait_option(sp)
     sp.set_defaults(handler=cmd_soak)

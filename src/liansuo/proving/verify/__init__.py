@@ -18,6 +18,7 @@ from liansuo.interlocking.table.build import InterlockingTable, Route
 from liansuo.kit.fit import fit_all, plural
 from liansuo.proving.oracle.pairs import PaperOracle
 from liansuo.proving.progress import progress
+from liansuo.proving.spread import WAIT_S
 from liansuo.proving.verify.against import approach_extent, pair_conflicts, route_demands, spec
 from liansuo.proving.verify.apart import near_masks, table_reach
 from liansuo.proving.verify.data import check_station
@@ -77,11 +78,13 @@ class VerifyReport:
 def verify_station(station: str | Path | Station, *, routes: list[str] | None = None, pairs: bool = True,
                    strict: bool = False, rules: RuleSet | None = None, cycle_s: float = 0.25,
                    stop_at_first: bool = False, workers: int = 0, scheduler: str | None = None,
-                   show_progress: bool | None = False, simulate_all: bool = False) -> VerifyReport:
+                   show_progress: bool | None = False, simulate_all: bool = False,
+                   cluster_wait_s: float = WAIT_S) -> VerifyReport:
     """Run the whole interlocking test; ``routes`` limits route and pair checks to those routes. The table is held
     against the oracle first (quick), then every unit of the dynamic test (:mod:`.plan`) runs: here, one after the
     other (``workers`` 0), or fanned out on Dask over ``workers`` local processes or the cluster at ``scheduler``
-    (:mod:`proving.spread`). The report is the same either way.
+    (:mod:`proving.spread`; ``cluster_wait_s``: how long to wait for that scheduler and its first worker). The report
+    is the same either way.
     Compatible pairs of routes apart (:mod:`.apart`) are proven without a simulation unless ``simulate_all``; those
     of a route that failed on its own are simulated after the other units.
     ``stop_at_first``: stop at the first failure (the mutation run only needs to know that one was found; here only).
@@ -99,7 +102,7 @@ def verify_station(station: str | Path | Station, *, routes: list[str] | None = 
     def run(units: list[Unit], what: str) -> list[UnitResult]:
         with progress(what, len(units), show=show_progress) as advance:
             if workers and not stop_at_first:
-                return spread_units(bench, units, workers, scheduler, advance)
+                return spread_units(bench, units, workers, scheduler, advance, cluster_wait_s)
             return list(run_here(bench, units, stop_at_first=stop_at_first, done=advance))
 
     with frozen():  # before planning too: on a hub the plan makes millions of objects, the table is millions more

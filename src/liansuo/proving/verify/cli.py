@@ -9,7 +9,7 @@ from collections.abc import Callable
 from liansuo.kit.arguments import count
 from liansuo.kit.exitcodes import Exit, bad_input, refuse
 from liansuo.kit.jsonreport import print_report
-from liansuo.proving.spread import SpreadError
+from liansuo.proving.spread import SpreadError, add_wait_option
 
 Add = Callable[..., argparse.ArgumentParser]
 
@@ -21,7 +21,8 @@ def cmd_verify(args: argparse.Namespace) -> int:
     try:
         rep = verify_station(args.station, routes=args.route, pairs=not args.no_pairs, strict=args.strict,
                              workers=args.workers or (1 if args.scheduler else 0), scheduler=args.scheduler,
-                             show_progress=None, simulate_all=args.simulate_all_pairs)
+                             show_progress=None, simulate_all=args.simulate_all_pairs,
+                             cluster_wait_s=args.cluster_wait)
     except StationError as exc:
         return bad_input(exc)
     except SpreadError as exc:
@@ -57,4 +58,5 @@ def register(add: Add) -> None:
     sp.add_argument("--scheduler", metavar="ADDRESS",
                     help="run on the Dask cluster whose scheduler is at ADDRESS (tcp://host:8786); "
                          "'liansuo docs cluster'")
+    add_wait_option(sp)
     sp.set_defaults(handler=cmd_verify)

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 from liansuo.interlocking.table.build import InterlockingTable, build_table
 from liansuo.proving.progress import Advance
-from liansuo.proving.spread import deal, fan_out
+from liansuo.proving.spread import WAIT_S, deal, fan_out
 from liansuo.proving.verify.lines import guide_area, line_direction
 from liansuo.proving.verify.pairs import PairTest
 from liansuo.proving.verify.plan import Unit, UnitResult
@@ -107,13 +107,13 @@ _BENCHES: dict[str, Bench] = {}  # in a worker process: the bench of the run in 
 
 
 def spread_units(bench: Bench, units: Sequence[Unit], workers: int, scheduler: str | None,
-                 advance: Advance) -> list[UnitResult]:
+                 advance: Advance, wait_s: float = WAIT_S) -> list[UnitResult]:
     """Every unit on Dask (:mod:`proving.spread`); results in the order of ``units``. Workers get the station and
     rules once and build the table themselves (it is derived, deterministic, and larger than its station)."""
     piles = deal(units, workers * PILES_PER_WORKER)
     shared = (uuid.uuid4().hex, bench.station, bench.rules, bench.cycle_s)
     done = fan_out(shared, [[units[i] for i in pile] for pile in piles], run_pile, workers=workers,
-                   scheduler=scheduler, advance=advance, size=len)
+                   scheduler=scheduler, advance=advance, size=len, wait_s=wait_s)
     out: list[UnitResult] = [UnitResult()] * len(units)
     for pile, results in zip(piles, done, strict=True):
         for i, res in zip(pile, results, strict=True):
