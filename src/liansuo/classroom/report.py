@@ -60,6 +60,8 @@ def text_report(report: dict[str, Any]) -> str:
     sealed = ", ".join(f"{k} {n}" for k, n in sorted(report["sealed_uses"].items())) or "none"
     out += ["", f"Sealed buttons used (铅封计数): {sealed}", "", "Commands:"]
     out += [f"  {_t(c['t'])} {'  ' if c['ok'] else '! '}{c['command']} -> {c['answer']}" for c in report["commands"]]
+    if report.get("commands_not_kept"):
+        out.append(f"  ... and {report['commands_not_kept']} more commands, not kept")
     out += ["", "Score:"] + [f"  {name:<24} {value:>12}" for name, value in _score_rows(report)]
     return "\n".join(out) + "\n"
 
@@ -94,6 +96,8 @@ def html_report(report: dict[str, Any]) -> str:
             [k, str(n)] for k, n in sorted(report["sealed_uses"].items())]),
         "<h2>Commands</h2>", _table(["time", "command", "accepted", "answer"], [
             [_t(c["t"]), c["command"], "yes" if c["ok"] else "refused", c["answer"]] for c in report["commands"]]),
+        *([f"<p>... and {report['commands_not_kept']} more commands, not kept</p>"]
+          if report.get("commands_not_kept") else []),
     ]
     style = ("body{font-family:sans-serif;margin:2em}table{border-collapse:collapse}"
              "td,th{border:1px solid #999;padding:2px 8px;text-align:left}")
