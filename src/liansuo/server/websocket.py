@@ -3,7 +3,7 @@
 A client's first message is a ``hello`` naming its role. A trainee gets one seat and its snapshots; the instructor
 (with the password) may watch any seat, send any command to any seat, and run the seats' clocks. The server answers
 every message; one it cannot read gets an ``error`` reply and changes nothing, and a client that disconnects may
-take its seat back with the token it was given.
+take its seat back with the token it was given (only that token: the instructor frees a seat for another trainee).
 """
 
 from __future__ import annotations
@@ -13,6 +13,7 @@ import json
 import sys
 import time
 import traceback
+from collections.abc import Coroutine
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -30,6 +31,7 @@ from liansuo.server.messages import (
     ClockMessage,
     CommandMessage,
     ExerciseMessage,
+    FreeMessage,
     HelloMessage,
     LobbyMessage,
     StopMessage,
@@ -56,6 +58,8 @@ class ClassroomServer:
         self.classroom = classroom
         self.instructor_hash = instructor_hash
         self.errors = 0  # unexpected errors answered and survived (their tracebacks went to stderr)
+        self.clients: dict[ServerConnection, Client] = {}
+        self._tasks: set[asyncio.Task[None]] = set()
 
     # ---- the loop -------------------------------------------------------------------------------------------------
     async def serve(self, host: str, port: int, ready: asyncio.Future[int] | None = None) -> None:
@@ -81,12 +85,14 @@ class ClassroomServer:
             client = await self.greet(ws)
             if client is None:
                 return
+            self.clients[ws] = client
             pusher = asyncio.create_task(self.push(ws, client))
             async for raw in ws:
                 await ws.send(json.dumps(self.answer(client, raw)))
         except ConnectionClosed:
             pass
         finally:
+            self.clients.pop(ws, None)
             if pusher is not None:
                 pusher.cancel()
             if client is not None and client.role == TRAINEE:
@@ -116,10 +122,11 @@ class ClassroomServer:
         return client
 
     def lobby(self) -> dict[str, Any]:
-        """What a login screen shows: the station and who sits where (no token, nothing of any seat's state)."""
+        """What a login screen shows: the station and which seats are taken (no names, no token, nothing of any seat's
+        state: whoever asks has not logged in)."""
         room = self.classroom
         return {"type": "lobby", "station": room.station_source(), "cycle_s": room.cycle_s, "shared": room.shared,
-                "seats": [{"seat": s.number, "trainee": s.trainee, "connected": s.connected}
+                "seats": [{"seat": s.number, "taken": bool(s.token), "connected": s.connected}
                           for s in room.seats.values()]}
 
     def admit(self, hello: HelloMessage) -> Client:
@@ -160,6 +167,8 @@ class ClassroomServer:
         instructor = client.role == INSTRUCTOR
         if isinstance(msg, HelloMessage | LobbyMessage):
             raise SeatError(f"a {msg.type} is sent once, first")
+        if not instructor and not self.classroom.holds(client.seat, client.token):
+            raise SeatError(f"the instructor freed seat {client.seat}: log in again")
         if isinstance(msg, CommandMessage):
             if msg.seat is not None and msg.seat != client.seat and not instructor:
                 raise SeatError("a trainee operates only their own seat")
@@ -186,6 +195,18 @@ class ClassroomServer:
             written = self.classroom.stop_exercise(seats)
             return {"type": "ok", "message": f"reports written: {', '.join(str(p) for p in written)}" if written
                     else "no exercise on those seats", "reports": [str(p) for p in written]}
+        if isinstance(msg, FreeMessage):
+            self.classroom.free(seats)
+            for ws, c in list(self.clients.items()):
+                if c.role == TRAINEE and c.seat in seats:
+                    self._later(ws.close(1008, f"the instructor freed seat {c.seat}"))
+            return {"type": "ok", "message": f"seats {', '.join(map(str, seats))} freed: a new trainee may take them"}
         self.classroom.reset(seats)
         client.cursor = EventCursor()
         return {"type": "ok", "message": f"seats {', '.join(map(str, seats))} reset"}
+
+    def _later(self, work: Coroutine[Any, Any, None]) -> None:
+        task = asyncio.create_task(work)
+        self._tasks.add(task)
+        task.add_done_callback(self._tasks.discard)
+
