@@ -1,27 +1,34 @@
-"""The classroom under attack (issue 45): a seat taken by a name, a log that grows without end. ``liansuo serve``
-runs in its own process and the attackers are raw websocket clients on localhost, as on a school's LAN
-(docs/classroom.md, "Security")."""
+"""The classroom under attack (issue 45): a seat taken by a name, a log that grows without end, one client flooding
+the class, passwords guessed in parallel. ``liansuo serve`` runs in its own process and the attackers are raw
+websocket clients on localhost, as on a school's LAN (docs/classroom.md, "Security")."""
 
 from __future__ import annotations
 
 import json
+import os
+import socket
+import statistics
 import subprocess
 import sys
+import threading
 import time
 import tracemalloc
 from collections.abc import Iterator
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import pytest
 from websockets.exceptions import ConnectionClosed
-from websockets.sync.client import connect
+from websockets.sync.client import ClientConnection, connect
 
 from liansuo.classroom.assessment import KEPT
 from liansuo.classroom.passwords import hash_password
 from liansuo.server.classroom import LOG_LINES, MAX_LINE, Classroom
 from liansuo.server.client import ClassroomClient, ClassroomError
+from liansuo.server.throttle import BURST, RATE
 
 PASSWORD = "correct horse"
+LOCKOUT_S = 2.0
 
 
 def serve(folder: Path, *extra: str) -> tuple[subprocess.Popen[str], str]:
@@ -39,7 +46,7 @@ def serve(folder: Path, *extra: str) -> tuple[subprocess.Popen[str], str]:
 @pytest.fixture
 def url(tmp_path: Path) -> Iterator[str]:
     """A fresh server for each test: a lockout or a flood never reaches the next test."""
-    proc, where = serve(tmp_path)
+    proc, where = serve(tmp_path, "--lockout", str(LOCKOUT_S))
     try:
         yield where
     finally:
@@ -162,3 +169,91 @@ def test_an_over_long_command_line_is_refused_over_the_wire(url: str) -> None:
         with pytest.raises(ConnectionClosed):
             while True:
                 li.ws.recv(timeout=10)
+
+
+# ---- 3. nobody freezes the class -----------------------------------------------------------------------------------
+def round_trips(client: ClassroomClient, n: int) -> list[float]:
+    out = []
+    for _ in range(n):
+        t0 = time.perf_counter()
+        reply = client.command("cancel X")
+        assert reply["type"] == "answer", reply  # answered, every time
+        out.append(time.perf_counter() - t0)
+        time.sleep(0.05)
+    return out
+
+
+def test_one_client_flooding_does_not_freeze_the_others(url: str) -> None:
+    sent = [0]
+
+    def flood(ws: ClientConnection) -> None:  # as fast as it can, reading nothing: back-pressure stops its sends
+        message = json.dumps({"type": "command", "id": 1, "line": "route X XI"})
+        try:
+            while sent[0] < 20_000:
+                ws.send(message)
+                sent[0] += 1
+        except (ConnectionClosed, OSError):
+            pass
+
+    with connect(url) as flooder, ClassroomClient.trainee(url, seat=1, name="Li") as li:
+        flooder.send(json.dumps({"type": "hello", "role": "trainee", "seat": 2, "name": "Flood"}))
+        assert json.loads(flooder.recv(timeout=10))["type"] == "welcome"
+        quiet = round_trips(li, 10)
+        thread = threading.Thread(target=flood, args=(flooder,), daemon=True)
+        t0 = time.perf_counter()
+        thread.start()
+        time.sleep(0.5)
+        loud = round_trips(li, 20)
+        with ClassroomClient.instructor(url, PASSWORD) as teacher:
+            seats = next(m for m in iter(teacher._next, None) if m.get("type") == "seats")["seats"]
+        elapsed = time.perf_counter() - t0
+        rate = sent[0] / elapsed
+        flooder.socket.shutdown(socket.SHUT_RDWR)  # unblocks the flooding thread's send
+        thread.join(10)
+        read = seats[1]["commands"]  # the flood's messages the server read (and ran) so far
+        print(f"\nthe server read {read} of the flood's messages in {elapsed:.1f} s")
+        assert read <= BURST + RATE * elapsed + 10, f"{read} of the flood's messages read in {elapsed:.1f} s"
+        print(f"honest round trip: median {statistics.median(quiet) * 1e3:.1f} ms quiet, "
+              f"{statistics.median(loud) * 1e3:.1f} ms (max {max(loud) * 1e3:.1f}) while one client sent "
+              f"{sent[0]} messages ({rate:.0f}/s)")
+        assert max(loud) < 5.0, loud  # loose: a loaded machine; the figure printed is the measure
+        assert li.command("route X XI")["type"] == "answer"
+
+
+def test_wrong_logins_in_parallel_do_not_block_a_trainee_and_lock_their_address_out(url: str) -> None:
+    with ClassroomClient.trainee(url, seat=1, name="Li") as li:
+        with ThreadPoolExecutor(50) as pool:
+            guesses = [pool.submit(hello, url, {"role": "instructor", "password": f"guess {i}"}) for i in range(200)]
+            during = round_trips(li, 10)
+            replies = [g.result(60) for g in guesses]
+        print(f"\nhonest round trip while 200 wrong logins arrive at once: median "
+              f"{statistics.median(during) * 1e3:.1f} ms, max {max(during) * 1e3:.1f} ms")
+        assert max(during) < 5.0, during
+    said = [str(r["message"]) for r in replies]
+    assert all(r["type"] == "error" for r in replies)
+    assert sum("wrong instructor password" in m for m in said) <= 5  # at most 5 guesses were checked
+    assert all("wrong instructor password" in m or "try again" in m for m in said), set(said)
+
+
+def test_after_five_wrong_passwords_the_address_waits_out_its_lockout(url: str) -> None:
+    for i in range(4):
+        assert hello(url, {"role": "instructor", "password": f"guess {i}"})["message"] == "wrong instructor password"
+    fifth = str(hello(url, {"role": "instructor", "password": "guess 4"})["message"])
+    assert fifth.startswith("wrong instructor password") and f"locked out for {LOCKOUT_S:g} s" in fifth, fifth
+    with pytest.raises(ClassroomError, match=r"locked out, try again in \d+ s"):  # even the right password
+        ClassroomClient.instructor(url, PASSWORD)
+    assert hello(url, {"role": "trainee", "seat": 1, "name": "Li"})["type"] == "welcome"  # trainees are not locked
+    time.sleep(LOCKOUT_S + 0.2)
+    with ClassroomClient.instructor(url, PASSWORD) as teacher:  # the lockout passed: the right password is let in
+        assert teacher.welcome["role"] == "instructor"
+    for i in range(5):  # the count starts again after a login, and five more wrong ones lock the address again
+        hello(url, {"role": "instructor", "password": f"guess {i}"})
+    reply = str(hello(url, {"role": "instructor", "password": PASSWORD})["message"])
+    assert "locked out, try again in" in reply, reply
+
+
+def test_the_lockout_is_given_in_seconds_from_0_to_3600() -> None:
+    for bad in ("-1", "nan", "7200"):
+        done = subprocess.run([sys.executable, "-m", "liansuo.cli", "serve", "--lockout", bad], capture_output=True,
+                              text=True, timeout=60, env={**os.environ, "LIANSUO_INSTRUCTOR_PASSWORD": "x"})
+        assert done.returncode == 2 and "--lockout is 0 to 3600 seconds" in done.stderr, done.stderr
