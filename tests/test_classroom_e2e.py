@@ -113,9 +113,11 @@ def test_two_trainees_at_terminals_the_instructor_and_a_scored_report(room: Clas
         for who in ("Li", "Wang"):
             assert "broken" not in screen(who), screen(who)
         until(lambda: seat_of(teacher, 1)["refused"] >= 1, what="Li's refusals counted for the instructor")
-        # Li's console is closed and opened again: the seat is Li's still, with its fault
+        # Li's console is closed and opened again: the seat is held for Li's token, which died with the console;
+        # a name alone takes no seat, so the instructor frees it, and Li sits again at the station with its fault
         subprocess.run([*TMUX, "kill-session", "-t", "Li"], check=True)
         until(lambda: not seat_of(teacher, 1)["connected"], what="seat 1 left")
+        assert teacher.request({"type": "free", "seats": [1]})["type"] == "ok"
         console("Li", room.ws, 1)
         until(lambda: "seat 1" in screen("Li") and seat_of(teacher, 1)["connected"], what="Li back at seat 1")
         type_in("Li", "route X XI")

@@ -35,6 +35,7 @@ from liansuo.simulation.unknown import UnknownId
 from liansuo.simulation.view import RouteView
 
 CHECK_EVERY_S = 1.0  # goals are checked once a simulated second (and after each command)
+KEPT = 1000  # commands, unsafe actions and diagnoses kept for the report, the first of each (the score is 0 by then)
 
 
 class ExerciseSetupError(Exception):
@@ -102,7 +103,9 @@ class Assessment:
         self.findings = self._findings()
         self.start = sim.t
         self.sealed_before = sim.sealed_uses()
-        self.entries: list[Entry] = []
+        self.entries: list[Entry] = []  # the first KEPT commands
+        self.commands = 0  # every command recorded, kept or not
+        self.refused = 0
         self.unsafe: list[UnsafeAction] = []
         self.diagnoses: list[Diagnosis] = []
         self.diagnosed_at: list[float | None] = [None] * len(self.findings)
@@ -185,10 +188,13 @@ class Assessment:
             return
         t = round(self.sim.t - self.start, 3)
         self._observe()
-        self.entries.append(Entry(t, line.strip(), result.ok, result.message))
+        self.commands += 1
+        self.refused += not result.ok
+        if len(self.entries) < KEPT:
+            self.entries.append(Entry(t, line.strip(), result.ok, result.message))
         if result.ok:
             why = self._unsafe(line)
-            if why:
+            if why and len(self.unsafe) < KEPT:
                 self.unsafe.append(UnsafeAction(t, line.strip(), *why))
             if command_word(line) == "diagnose":
                 self._diagnose(t, " ".join(_words(line)[1:]))
@@ -232,16 +238,17 @@ class Assessment:
             if said in f.accept:
                 if self.diagnosed_at[i] is None:
                     self.diagnosed_at[i] = t
-                self.diagnoses.append(Diagnosis(t, said, True, f.finding))
+                if len(self.diagnoses) < KEPT:
+                    self.diagnoses.append(Diagnosis(t, said, True, f.finding))
                 return
-        self.diagnoses.append(Diagnosis(t, said, False, ""))
+        if len(self.diagnoses) < KEPT:
+            self.diagnoses.append(Diagnosis(t, said, False, ""))
 
     # ---- results ----------------------------------------------------------------------------------------------
     def _score(self) -> dict[str, float]:
         goals = tuple((g.points, at) for g, at in zip(self.exercise.goals, self.goal_met_at, strict=True))
         wrong = sum(not d.correct for d in self.diagnoses)
-        refused = sum(not e.ok for e in self.entries)
-        return score(self.exercise.scoring, ScoreInputs(goals, tuple(self.diagnosed_at), refused, len(self.unsafe),
+        return score(self.exercise.scoring, ScoreInputs(goals, tuple(self.diagnosed_at), self.refused, len(self.unsafe),
                                                         wrong, self.exercise.time_limit))
 
     def sealed_uses(self) -> dict[str, int]:
@@ -255,7 +262,7 @@ class Assessment:
         return {"elapsed_s": self.elapsed, "time_left_s": round(max(0.0, self.exercise.time_limit - self.elapsed), 3),
                 "goals_met": met, "goals": len(self.goal_met_at),
                 "diagnosed": sum(t is not None for t in self.diagnosed_at), "findings": len(self.findings),
-                "refused": sum(not e.ok for e in self.entries), "unsafe": len(self.unsafe),
+                "refused": self.refused, "unsafe": len(self.unsafe),
                 "score": self._score()["total"], "finished": self.finished, "ended": self.ended}
 
     def report(self) -> dict[str, Any]:
@@ -270,7 +277,8 @@ class Assessment:
             "time_limit_s": ex.time_limit, "elapsed_s": self.elapsed, "finished": self.finished,
             "ended": self.ended or "stopped before the end",
             "commands": [{"t": e.t, "command": e.line, "ok": e.ok, "answer": e.answer} for e in self.entries],
-            "refused": sum(not e.ok for e in self.entries),
+            "commands_not_kept": self.commands - len(self.entries),
+            "refused": self.refused,
             "unsafe": [{"t": u.t, "command": u.line, "rule": u.rule, "why": u.why} for u in self.unsafe],
             "findings": [{"finding": f.finding, "fault": f.fault, "accept": list(f.accept), "diagnosed_at": at}
                          for f, at in zip(self.findings, self.diagnosed_at, strict=True)],

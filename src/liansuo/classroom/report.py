@@ -62,6 +62,8 @@ def text_report(report: dict[str, Any]) -> str:
     sealed = ", ".join(f"{k} {n}" for k, n in sorted(report["sealed_uses"].items())) or "none"
     out += ["", f"Sealed buttons used (铅封计数): {sealed}", "", "Commands:"]
     out += [f"  {_t(c['t'])} {'  ' if c['ok'] else '! '}{c['command']} -> {c['answer']}" for c in report["commands"]]
+    if report.get("commands_not_kept"):
+        out.append(f"  ... and {report['commands_not_kept']} more commands, not kept")
     out += ["", "Score:"] + [f"  {name:<24} {value:>12}" for name, value in _score_rows(report)]
     return "\n".join(out) + "\n"
 
@@ -94,7 +96,8 @@ def html_report(report: dict[str, Any]) -> str:
     return _template().render(
         title=ex["title"], who=_who(report), station=report["station"], difficulty=report["difficulty"],
         seed=report["seed"], elapsed=_t(report["elapsed_s"]), limit=_t(report["time_limit_s"]), ended=report["ended"],
-        faults=", ".join(_faults(report)) or "none", sections=sections)
+        faults=", ".join(_faults(report)) or "none", sections=sections,
+        not_kept=report.get("commands_not_kept", 0))
 
 
 def write_report(report: dict[str, Any], directory: str | Path, stem: str) -> list[Path]:

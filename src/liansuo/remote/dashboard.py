@@ -3,8 +3,8 @@ messages, and the instructor's controls of them.
 
 Enter opens the selected seat's diagram (live: the server sends its snapshots); ``p`` / ``r`` pause and run the
 selected seat's clock, ``x`` resets it, ``e`` starts an exercise on it and ``s`` stops it (writing its report); the
-same keys shifted act on every seat. Every answer of the server, a refusal included, shows on the dashboard's
-answer line.
+same keys shifted act on every seat; ``f`` frees the selected seat for another trainee (its token cleared). Every
+answer of the server, a refusal included, shows on the dashboard's answer line.
 """
 
 from __future__ import annotations
@@ -121,6 +121,7 @@ class DashboardScreen(Screen[None]):
         Binding("x", "reset(False)", "reset"),
         Binding("e", "exercise(False)", "exercise"),
         Binding("s", "stop(False)", "stop"),
+        Binding("f", "free", "free seat"),
         Binding("P", "clock('pause', True)", "pause all"),
         Binding("R", "clock('run', True)", "run all"),
         Binding("X", "reset(True)", "reset all", show=False),
@@ -147,7 +148,7 @@ class DashboardScreen(Screen[None]):
         yield DataTable(id="seats", cursor_type="row", zebra_stripes=True)
         with Horizontal(id="buttons"):
             for bid, label in (("open", "Open"), ("pause", "Pause"), ("run", "Run"), ("reset", "Reset"),
-                               ("exercise", "Exercise"), ("stop", "Stop"), ("pause-all", "Pause all"),
+                               ("exercise", "Exercise"), ("stop", "Stop"), ("free", "Free"), ("pause-all", "Pause all"),
                                ("run-all", "Run all"), ("back", "Diagram")):
                 yield Button(label, id=f"b-{bid}", compact=True)
         yield Static(id="answer")
@@ -226,6 +227,10 @@ class DashboardScreen(Screen[None]):
         if (seats := self._seats(every)) is not None:
             self._send({"type": "stop", "seats": seats})
 
+    def action_free(self) -> None:
+        if (seats := self._seats(False)) is not None:
+            self._send({"type": "free", "seats": seats})
+
     def action_exercise(self, every: bool) -> None:
         seats = self._seats(every)
         if seats is None:
@@ -244,8 +249,8 @@ class DashboardScreen(Screen[None]):
         {"open": self.action_open, "pause": lambda: self.action_clock("pause", False),
          "run": lambda: self.action_clock("run", False), "reset": lambda: self.action_reset(False),
          "exercise": lambda: self.action_exercise(False), "stop": lambda: self.action_stop(False),
-         "pause-all": lambda: self.action_clock("pause", True), "run-all": lambda: self.action_clock("run", True),
-         "back": self.action_back}.get(action, lambda: None)()
+         "free": self.action_free, "pause-all": lambda: self.action_clock("pause", True),
+         "run-all": lambda: self.action_clock("run", True), "back": self.action_back}.get(action, lambda: None)()
 
 
 

@@ -33,11 +33,12 @@ def hello_of(role: str, name: str, seat: str, password: str) -> dict[str, Any] |
 
 
 def seats_text(lobby: dict[str, Any]) -> str:
-    """Who sits where, as the login screen lists it: '1 Li Lei · 2 free · 3 Wang (away)'."""
+    """Which seats are free, as the login screen lists them: '1 taken · 2 free · 3 taken (away)' (the lobby names
+    nobody: whoever reads it has not logged in)."""
     out = []
     for s in lobby.get("seats", []):
-        who = str(s.get("trainee") or "")
-        out.append(f"{s.get('seat')} {who or 'free'}{' (away)' if who and not s.get('connected') else ''}")
+        state = "free" if not s.get("taken") else "taken" if s.get("connected") else "taken (away)"
+        out.append(f"{s.get('seat')} {state}")
     return " · ".join(out)
 
 

@@ -7,10 +7,13 @@ simulation itself never reads the wall clock.
 
 from __future__ import annotations
 
+import hmac
 import re
 import secrets
 import sys
 import traceback
+import unicodedata
+from collections import deque
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -26,6 +29,11 @@ from liansuo.simulation.sim import Simulation
 from liansuo.stations.library import bundled
 
 MAX_STEPS = 400  # cycles one seat may catch up in one advance: a stalled server does not freeze on its return
+MAX_LINE = 500  # characters in one command line: the longest the language needs is under 100
+LOG_LINES = 1000  # a seat keeps its newest commands and answers, no more: a trainee's flood takes no memory
+NOT_SHOWN = frozenset({"Cc", "Cf", "Cs", "Co", "Cn", "Zl", "Zp"})  # controls, format (bidi), line breaks, unassigned
+
+LogEntry = tuple[float, str, str, bool, str]  # (t, who, line, ok, answer)
 
 
 @dataclass
@@ -46,14 +54,19 @@ class Seat:
     number: int
     desk: Desk
     trainee: str = ""
-    token: str = ""  # held by the client that took the seat; a reconnect shows it to take the seat back
-    connected: bool = False
+    token: str = ""  # held by the client that took the seat; only it takes the seat back, until the seat is freed
+    holders: int = 0  # the connections open with the token (a reconnect may come before the old one is seen gone)
     refused: int = 0  # the trainee's refused commands
-    log: list[tuple[float, str, str, bool, str]] = field(default_factory=list)  # (t, who, line, ok, answer)
+    commands: int = 0  # the trainee's commands
+    log: deque[LogEntry] = field(default_factory=lambda: deque(maxlen=LOG_LINES))  # the newest LOG_LINES
 
     @property
     def sim(self) -> Simulation:
         return self.desk.sim
+
+    @property
+    def connected(self) -> bool:
+        return self.holders > 0
 
     def summary(self) -> dict[str, Any]:
         """What the instructor's dashboard shows of this seat."""
@@ -62,7 +75,7 @@ class Seat:
         return {"seat": self.number, "station": d.sim.station.id, "trainee": self.trainee,
                 "connected": self.connected, "t": d.sim.t, "paused": d.paused, "speed": d.speed,
                 "alarms": len(d.sim.alarm_views()), "refused": self.refused,
-                "commands": sum(w != INSTRUCTOR for _, w, *_ in self.log),
+                "commands": self.commands,
                 "exercise": None if d.assessment is None else d.assessment.exercise.name,
                 "progress": progress, "score": None if progress is None else progress["score"],
                 "reports": [str(p) for p in d.reported], "broken": d.broken}
@@ -134,40 +147,63 @@ class Classroom:
         return s
 
     def take(self, number: int, trainee: str, token: str | None) -> str:
-        """Give seat ``number`` to a client; the token it must show to take the seat back after a disconnect."""
+        """Give seat ``number`` to a client: a free seat to anyone, a taken one (connected or not) only to the client
+        showing its token, never for a name. Returns the token, which takes the seat back after a disconnect."""
         s = self.seat(number)
-        if s.token and token != s.token:
-            if s.connected:
-                raise SeatError(f"seat {number} is taken by {s.trainee or 'another trainee'}")
-            if s.trainee and trainee != s.trainee:
-                raise SeatError(f"seat {number} belongs to {s.trainee}, who may come back to it")
-        if not s.token or token != s.token:
-            s.token = secrets.token_hex(16)
-        s.trainee = trainee or s.trainee
-        s.connected = True
+        name = trainee_name(trainee)
+        if s.token:
+            if token is None or not hmac.compare_digest(token.encode(), s.token.encode()):
+                if s.connected:
+                    raise SeatError(f"seat {number} is taken: choose a free seat")
+                raise SeatError(f"seat {number} is held for its trainee, who takes it back with the seat's token: "
+                                "choose a free seat, or ask the instructor to free this one")
+        else:
+            s.token, s.trainee = secrets.token_hex(16), name
+        s.holders += 1
         return s.token
 
     def leave(self, number: int, token: str) -> None:
+        """A connection that held seat ``number`` with ``token`` closed (the seat stays its trainee's)."""
         s = self.seats.get(number)
-        if s is not None and s.token == token:
-            s.connected = False
+        if s is not None and s.token and s.token == token:
+            s.holders = max(0, s.holders - 1)
+
+    def holds(self, number: int, token: str) -> bool:
+        """Whether ``token`` still holds seat ``number`` (the instructor may have freed it)."""
+        s = self.seats.get(number)
+        return s is not None and bool(s.token) and hmac.compare_digest(token.encode(), s.token.encode())
+
+    def free(self, seats: list[int]) -> None:
+        """The instructor frees these seats: token and trainee cleared, so that a new trainee may sit (their station
+        and exercise stay as they are: reset them for a fresh one). Whoever held them holds them no more."""
+        for n in seats:
+            self.seat(n)
+        for n in seats:
+            s = self.seats[n]
+            s.token, s.trainee, s.holders = "", "", 0
 
     # ---- commands and the clock ---------------------------------------------------------------------------------
     def command(self, seat: int, role: str, line: str) -> Result:
         """Send one line to a seat's simulation for ``role``: a trainee's instructor command is refused and changes
         nothing; ``run`` is the server's clock, never a client's."""
         s = self.seat(seat)
-        no = refusal(role, line)
+        if len(line) > MAX_LINE:
+            no: Result | None = Result.refuse(f"a command line is at most {MAX_LINE} characters, not {len(line)}: "
+                                              "send one command a line")
+            line = line[:60] + "…"
+        else:
+            no = refusal(role, line)
         if no is None and command_word(line) == "run":  # as the language reads it: 'run' 60s is run too
             no = Result.refuse("the classroom's clock runs on the server: pause, run or change its speed instead")
         result = no if no is not None else s.sim.command(line)
-        if role != INSTRUCTOR and not result.ok:
-            s.refused += 1
+        if role != INSTRUCTOR:
+            s.commands += 1
+            s.refused += not result.ok
         a = s.desk.assessment
         if role != INSTRUCTOR and a is not None and not a.finished:
             a.record(line, result)
             self._report_if_ended(s.desk)
-        s.log.append((s.sim.t, role, line, result.ok, result.message))
+        s.log.append((s.sim.t, role, line, result.ok, result.message[:MAX_LINE]))
         return result
 
     def set_clock(self, seats: list[int], *, paused: bool | None = None, speed: float | None = None) -> None:
@@ -192,7 +228,8 @@ class Classroom:
         d.sim, d.debt, d.assessment, d.reported, d.broken = sim, 0.0, None, [], ""
         for s in self.seats.values():
             if s.desk is d:
-                s.refused, s.log = 0, []
+                s.refused, s.commands = 0, 0
+                s.log.clear()
 
     # ---- exercises --------------------------------------------------------------------------------------------
     def exercise_names(self) -> list[str]:
@@ -292,6 +329,16 @@ class Classroom:
     def close(self) -> None:
         for d in self.desks():
             d.sim.close()
+
+
+def trainee_name(name: str) -> str:
+    """A trainee's name as given, trimmed; refused if it holds a character that is not shown as itself (a control
+    character such as ESC, a bidirectional override, a line break): names reach the instructor's screen and reports."""
+    bad = next((c for c in name if unicodedata.category(c) in NOT_SHOWN), None)
+    if bad is not None:
+        raise SeatError(f"a trainee's name is letters, digits, spaces and punctuation, not U+{ord(bad):04X}: "
+                        "give your name as you would write it")
+    return name.strip()
 
 
 def _slug(name: str) -> str:

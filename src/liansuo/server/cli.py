@@ -47,6 +47,9 @@ def register(add: Add) -> None:
     sp.add_argument("--public-url", metavar="URL",
                     help="with --web: the address browsers use to reach this machine, when it is not "
                          "http://HOST:PORT (behind a proxy, or --host 0.0.0.0)")
+    sp.add_argument("--lockout", type=float, default=60.0, metavar="S",
+                    help="after 5 wrong instructor passwords from one address, refuse it for S seconds, twice as long "
+                         "at each lockout after (default 60, at most 3600)")
     sp.add_argument("--hash-password", action="store_true",
                     help="read a password on the terminal (or standard input), print its hash for --password-file, "
                          "and exit")
@@ -64,6 +67,8 @@ def cmd_serve(args: argparse.Namespace) -> int:
     for name, port in (("--port", args.port), ("--web-port", args.web_port)):
         if not 0 <= port <= 65535:
             return refuse("serve", f"{name} is 0 to 65535, not {port}", Exit.USAGE)
+    if not 0 <= args.lockout <= 3600:
+        return refuse("serve", f"--lockout is 0 to 3600 seconds, not {args.lockout:g}", Exit.USAGE)
     if args.web and args.public_url is None and args.host in ("0.0.0.0", "::", ""):
         return refuse("serve", f"with --host {args.host} and --web, give --public-url http://ADDRESS:{args.web_port} "
                       "(this machine's address as the classroom's browsers reach it): the page tells them where to "
@@ -88,7 +93,7 @@ def cmd_serve(args: argparse.Namespace) -> int:
         return bad_input(exc)
     except SeatError as exc:
         return refuse("serve", str(exc), Exit.USAGE)
-    server = ClassroomServer(classroom, stored)
+    server = ClassroomServer(classroom, stored, lockout_s=args.lockout)
     web_port: int | None = None
     if args.web:
         try:

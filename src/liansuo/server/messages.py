@@ -33,7 +33,7 @@ class LobbyMessage(_Message):
 class CommandMessage(_Message):
     type: Literal["command"]
     id: int = Field(ge=0, le=2**53)
-    line: str = Field(max_length=2000)
+    line: str = Field(description="one line of the command language; past 500 characters it is refused")
     seat: int | None = Field(None, ge=1, le=64, description="the instructor's target seat; a trainee's is its own")
 
 
@@ -54,6 +54,13 @@ class ResetMessage(_Message):
     seats: Seats
 
 
+class FreeMessage(_Message):
+    """The instructor frees seats: their tokens and trainees are cleared, a new trainee may sit."""
+
+    type: Literal["free"]
+    seats: Seats
+
+
 class ExerciseMessage(_Message):
     type: Literal["exercise"]
     seats: Seats
@@ -68,7 +75,7 @@ class StopMessage(_Message):
 
 
 ClientMessage = (HelloMessage | LobbyMessage | CommandMessage | WatchMessage | ClockMessage | ResetMessage
-                 | ExerciseMessage | StopMessage)
+                 | ExerciseMessage | StopMessage | FreeMessage)
 Message = Annotated[ClientMessage, Field(discriminator="type")]
 MESSAGE: TypeAdapter[ClientMessage] = TypeAdapter(Message)
 

@@ -3,7 +3,11 @@
 A client's first message is a ``hello`` naming its role. A trainee gets one seat and its snapshots; the instructor
 (with the password) may watch any seat, send any command to any seat, and run the seats' clocks. The server answers
 every message; one it cannot read gets an ``error`` reply and changes nothing, and a client that disconnects may
-take its seat back with the token it was given.
+take its seat back with the token it was given (only that token: the instructor frees a seat for another trainee).
+
+No client can freeze the class: each connection's messages are read at a bounded rate (:mod:`.throttle`), and the
+instructor's password is checked off the event loop, one check at a time, with a lockout per address
+(:mod:`.lockout`).
 """
 
 from __future__ import annotations
@@ -13,6 +17,8 @@ import json
 import sys
 import time
 import traceback
+from collections.abc import Coroutine
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -24,23 +30,27 @@ from liansuo.classroom.passwords import matches
 from liansuo.classroom.roles import INSTRUCTOR, TRAINEE
 from liansuo.classroom.snapshot import EventCursor
 from liansuo.server.classroom import Classroom, SeatError
+from liansuo.server.lockout import FAILURES, LOCKOUT_S, LoginGuard
 from liansuo.server.messages import (
     MESSAGE,
     ClientMessage,
     ClockMessage,
     CommandMessage,
     ExerciseMessage,
+    FreeMessage,
     HelloMessage,
     LobbyMessage,
     StopMessage,
     WatchMessage,
     problem,
 )
+from liansuo.server.throttle import BURST, RATE, TokenBucket
 
 TICK_S = 0.05  # the clocks' pace on the wall clock
 PUSH_S = 0.25  # a snapshot to each client this often
 MAX_MESSAGE = 64 * 1024
 HELLO_TIMEOUT_S = 10.0
+MAX_CHECKS = 16  # instructor password checks waiting or running at once, from every address together
 
 
 @dataclass
@@ -52,19 +62,32 @@ class Client:
 
 
 class ClassroomServer:
-    def __init__(self, classroom: Classroom, instructor_hash: str) -> None:
+    def __init__(self, classroom: Classroom, instructor_hash: str, *, rate: float = RATE, burst: float = BURST,
+                 failures: int = FAILURES, lockout_s: float = LOCKOUT_S) -> None:
+        """``rate`` and ``burst``: how fast each connection's messages are read (:class:`.TokenBucket`);
+        ``failures`` and ``lockout_s``: the wrong passwords from one address before it is locked out, and for how
+        long at first (:class:`.LoginGuard`)."""
         self.classroom = classroom
         self.instructor_hash = instructor_hash
         self.errors = 0  # unexpected errors answered and survived (their tracebacks went to stderr)
+        TokenBucket(0.0, rate, burst)  # a rate or burst it cannot use is refused here, not at the first message
+        self.rate, self.burst = rate, burst
+        self.guard = LoginGuard(failures, lockout_s)
+        self.clients: dict[ServerConnection, Client] = {}
+        self._checks = 0  # password checks waiting or running
+        self._hasher: ThreadPoolExecutor | None = None  # the password checks' one thread, while serving
+        self._tasks: set[asyncio.Task[None]] = set()
 
     # ---- the loop -------------------------------------------------------------------------------------------------
     async def serve(self, host: str, port: int, ready: asyncio.Future[int] | None = None) -> None:
         """Serve until cancelled; ``ready`` gets the port listened on (useful with port 0)."""
-        async with serve(self.handle, host, port, max_size=MAX_MESSAGE) as server:
-            bound = next(iter(server.sockets)).getsockname()[1]
-            if ready is not None:
-                ready.set_result(bound)
-            await self.run_clocks()
+        with ThreadPoolExecutor(1, thread_name_prefix="liansuo-password") as hasher:
+            self._hasher = hasher
+            async with serve(self.handle, host, port, max_size=MAX_MESSAGE) as server:
+                bound = next(iter(server.sockets)).getsockname()[1]
+                if ready is not None:
+                    ready.set_result(bound)
+                await self.run_clocks()
 
     async def run_clocks(self) -> None:
         last = time.monotonic()
@@ -81,12 +104,19 @@ class ClassroomServer:
             client = await self.greet(ws)
             if client is None:
                 return
+            self.clients[ws] = client
             pusher = asyncio.create_task(self.push(ws, client))
+            bucket = TokenBucket(time.monotonic(), self.rate, self.burst)
             async for raw in ws:
+                wait = bucket.take(time.monotonic())
+                if wait > 0:  # nothing more is read from this client meanwhile: its own sends stall, not the class
+                    await asyncio.sleep(wait)
                 await ws.send(json.dumps(self.answer(client, raw)))
+                await asyncio.sleep(0)  # the other clients' turn, even while this one's messages are all there
         except ConnectionClosed:
             pass
         finally:
+            self.clients.pop(ws, None)
             if pusher is not None:
                 pusher.cancel()
             if client is not None and client.role == TRAINEE:
@@ -103,7 +133,7 @@ class ClassroomServer:
                 return None
             if not isinstance(hello, HelloMessage):
                 raise SeatError("the first message is a hello: {\"type\": \"hello\", \"role\": ...}")
-            client = self.admit(hello)
+            client = await self.admit(hello, _address(ws))
         except (TimeoutError, ValidationError, SeatError, ValueError) as exc:
             why = problem(exc) if isinstance(exc, ValidationError) else str(exc) or "no hello in time"
             await ws.send(json.dumps({"type": "error", "message": why}))
@@ -116,21 +146,41 @@ class ClassroomServer:
         return client
 
     def lobby(self) -> dict[str, Any]:
-        """What a login screen shows: the station and who sits where (no token, nothing of any seat's state)."""
+        """What a login screen shows: the station and which seats are taken (no names, no token, nothing of any seat's
+        state: whoever asks has not logged in)."""
         room = self.classroom
         return {"type": "lobby", "station": room.station_source(), "cycle_s": room.cycle_s, "shared": room.shared,
-                "seats": [{"seat": s.number, "trainee": s.trainee, "connected": s.connected}
+                "seats": [{"seat": s.number, "taken": bool(s.token), "connected": s.connected}
                           for s in room.seats.values()]}
 
-    def admit(self, hello: HelloMessage) -> Client:
+    async def admit(self, hello: HelloMessage, address: str) -> Client:
         if hello.role == INSTRUCTOR:
-            if hello.password is None or not matches(hello.password, self.instructor_hash):
-                raise SeatError("wrong instructor password")
+            await self.check_password(hello.password, address)
             return Client(INSTRUCTOR, 1)
         if hello.seat is None:
             raise SeatError("a trainee names a seat: {\"seat\": N}")
         token = self.classroom.take(hello.seat, hello.name, hello.token)
         return Client(TRAINEE, hello.seat, token)
+
+    async def check_password(self, password: str | None, address: str) -> None:
+        """Raise SeatError unless ``password`` is the instructor's and ``address`` may try it now. The scrypt check
+        runs on a thread of its own, one at a time: the event loop, and every seat's class, go on meanwhile."""
+        if self._checks >= MAX_CHECKS:
+            raise SeatError("the server is busy checking instructor passwords: try again in a few seconds")
+        no = self.guard.begin(address, time.monotonic())
+        if no is not None:
+            raise SeatError(no)
+        self._checks += 1
+        ok = False
+        try:
+            if password is not None:
+                ok = await asyncio.get_running_loop().run_in_executor(self._hasher, matches, password,
+                                                                      self.instructor_hash)
+        finally:
+            self._checks -= 1
+            locked = self.guard.end(address, ok, time.monotonic())
+        if not ok:
+            raise SeatError(f"wrong instructor password{f': {locked}' if locked else ''}")
 
     async def push(self, ws: ServerConnection, client: Client) -> None:
         n = 0
@@ -160,6 +210,8 @@ class ClassroomServer:
         instructor = client.role == INSTRUCTOR
         if isinstance(msg, HelloMessage | LobbyMessage):
             raise SeatError(f"a {msg.type} is sent once, first")
+        if not instructor and not self.classroom.holds(client.seat, client.token):
+            raise SeatError(f"the instructor freed seat {client.seat}: log in again")
         if isinstance(msg, CommandMessage):
             if msg.seat is not None and msg.seat != client.seat and not instructor:
                 raise SeatError("a trainee operates only their own seat")
@@ -186,6 +238,23 @@ class ClassroomServer:
             written = self.classroom.stop_exercise(seats)
             return {"type": "ok", "message": f"reports written: {', '.join(str(p) for p in written)}" if written
                     else "no exercise on those seats", "reports": [str(p) for p in written]}
+        if isinstance(msg, FreeMessage):
+            self.classroom.free(seats)
+            for ws, c in list(self.clients.items()):
+                if c.role == TRAINEE and c.seat in seats:
+                    self._later(ws.close(1008, f"the instructor freed seat {c.seat}"))
+            return {"type": "ok", "message": f"seats {', '.join(map(str, seats))} freed: a new trainee may take them"}
         self.classroom.reset(seats)
         client.cursor = EventCursor()
         return {"type": "ok", "message": f"seats {', '.join(map(str, seats))} reset"}
+
+    def _later(self, work: Coroutine[Any, Any, None]) -> None:
+        task = asyncio.create_task(work)
+        self._tasks.add(task)
+        task.add_done_callback(self._tasks.discard)
+
+
+def _address(ws: ServerConnection) -> str:
+    """The client's address, without its port: what a lockout applies to."""
+    peer = ws.remote_address
+    return str(peer[0]) if isinstance(peer, tuple) and peer else "unknown"
