@@ -260,3 +260,26 @@ def test_the_docs_list_every_limit() -> None:
     for x in vars(limits).values():
         if isinstance(x, limits.Limit):
             assert f"| {x.what} | {x.range_text()} |" in text, x.what
+
+
+def test_a_station_past_its_size_limit_is_refused_at_its_list(tmp_path: Path) -> None:
+    """Issue 45, item 7: 10,000 signals passed check and then took gigabytes in table and verify. Each list of a
+    station file has a size limit (stations/limits.py); past it, check refuses the file where the list starts."""
+    from liansuo.stations.limits import STATION_ITEMS
+
+    most = STATION_ITEMS["signals"]
+    joints = "".join(f"  - {{id: J{i}, at: {i}}}\n" for i in range(1, most + 2))
+    tracks = "".join(f"  - {{id: t{i}, from: J{i}, to: J{i + 1}, section: S}}\n" for i in range(1, most + 1))
+    signals = "".join(f"  - {{id: D{i}, kind: shunting, at: J{i}, direction: down, lamps: [A, B], buttons: [shunt]}}\n"
+                      for i in range(1, most + 2))
+    text = ("id: big\nname: {zh: 大站, en: Big}\nends:\n  - {id: XB, kind: boundary, at: 0}\n"
+            f"joints:\n{joints}tracks:\n  - {{id: t0, from: XB, to: J1, section: S}}\n{tracks}"
+            f"sections:\n  - {{id: S, type: 25hz}}\nsignals:\n{signals}")
+    path = write(tmp_path, text)
+    proc = subprocess.run([sys.executable, "-m", "liansuo", "check", str(path)], capture_output=True, text=True,
+                          check=False, timeout=300)
+    line = text[:text.index("signals:\n")].count("\n") + 2  # the list's first item
+    assert proc.returncode == Exit.BAD_INPUT, proc.stderr
+    assert proc.stderr.startswith(f"{path}:{line}:3: error: signals: a station has at most {most:,} signals, not "
+                                  f"{most + 1:,}: larger than any real station"), proc.stderr
+    assert "Traceback" not in proc.stderr

@@ -162,3 +162,15 @@ SWITCH_FORCE = Limit(
 ODOMETRY_BOUND = Limit(
     "an odometry error bound", "m", 0.0, EXTENT.high,
     "the error an 'expect odometry' allows: within the station")
+
+
+# How many items each list of a station file may hold (StationFile in :mod:`.schema`). The largest real stations
+# (hubs such as Zhengzhou North) have some 1,000 signals and 600 turnouts; the generated hub of 2,000 turnouts and
+# 400 station tracks (liansuo generate hub), far beyond them, has 3,208 signals, 25,124 tracks and 21,124 sections
+# and takes some 20 s and 0.5 GB to check or table on one core (docs/robustness.md, "Station size"). A station past
+# these counts is refused by check, before any work grows with it.
+STATION_ITEMS: dict[str, int] = {
+    "ends": 2_000, "joints": 30_000, "turnouts": 2_500, "tracks": 30_000, "sections": 30_000, "signals": 4_000,
+    "buttons": 2_000, "fouling_points": 5_000, "diamonds": 1_000, "double_slips": 1_000, "profile": 5_000,
+    "markers": 5_000, "platforms": 1_000, "links": 1_000, "overlaps": 5_000,
+}

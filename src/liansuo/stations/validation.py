@@ -11,6 +11,7 @@ from typing import Any, TypeVar
 from pydantic import BaseModel, ValidationError
 
 from liansuo.kit.source import Diagnostic, Source
+from liansuo.stations import limits
 
 M = TypeVar("M", bound=BaseModel)
 
@@ -26,7 +27,8 @@ _HINTS = {
     "list_type": "write a list ('- item' lines)",
     "model_type": "write a mapping ('key: value' lines)",
     "too_short": "add items: the message says how many the list needs",
-    "too_long": "remove items: the message says how many the list takes",
+    "too_long": "remove items: the message says how many the list takes; a whole station past its size limits "
+                "('liansuo docs robustness', 'Station size') is split into stations joined by links",
     "string_too_short": "write a non-empty text",
     "int_from_float": "write a whole number",
     "greater_than": "write a larger number",
@@ -47,6 +49,10 @@ def _describe(err: Any) -> str:
     if kind == "missing":
         return f"missing key '{loc[-1]}'"
     msg = str(err["msg"])
+    if kind == "too_long" and len(loc) == 1 and str(loc[0]) in limits.STATION_ITEMS:  # a station's own list
+        most, have = err["ctx"]["max_length"], err["ctx"].get("actual_length")
+        return (f"{where}: a station has at most {most:,} {str(loc[0]).replace('_', ' ')}"
+                f"{f', not {have:,}' if have is not None else ''}: larger than any real station")
     if msg.startswith("Value error, "):
         msg = msg[len("Value error, "):]
     value = err.get("input")
