@@ -53,3 +53,24 @@ def test_malformed_script_gives_file_and_line(tmp_path: Path, capsys: pytest.Cap
     assert main(["test", str(f)]) == 3  # a bad input file
     err = capsys.readouterr().err
     assert f"{f}:5:9: error: unknown command 'rout'" in err and "Traceback" not in err
+
+
+def test_a_script_naming_a_file_that_is_no_station_shows_nothing_of_it(tmp_path: Path) -> None:
+    """Issue 45, item 8: a script (or scenario) handed over may name any file as its station; one that is no station
+    file is refused at the script in one line, none of its keys or lines quoted."""
+    import subprocess
+    import sys
+
+    secret = tmp_path / "elsewhere" / "secret.yaml"
+    secret.parent.mkdir()
+    secret.write_text("api_key_name: do-not-show\nroot: x\n", encoding="utf-8")
+    script = tmp_path / "scripts" / "evil.yaml"
+    script.parent.mkdir()
+    script.write_text("station: ../elsewhere/secret.yaml\ntests:\n  - name: a\n    steps: ['route X XI']\n",
+                      encoding="utf-8")
+    proc = subprocess.run([sys.executable, "-m", "liansuo", "test", str(script)], capture_output=True, text=True,
+                          check=False, timeout=120)
+    assert proc.returncode == 3, proc.stderr
+    assert proc.stderr.startswith(f"{script}:1:1: error: its station ../elsewhere/secret.yaml is not a station file"), \
+        proc.stderr
+    assert "api_key_name" not in proc.stdout + proc.stderr and "do-not-show" not in proc.stdout + proc.stderr

@@ -25,8 +25,7 @@ from liansuo.kit.printable import printable
 from liansuo.kit.source import Diagnostic, StationError
 from liansuo.proving.fileschemas import ScenarioFile
 from liansuo.simulation.sim import LANGUAGE, Simulation
-from liansuo.stations.library import resolve_from
-from liansuo.stations.loader import load
+from liansuo.stations.loader import load_named
 from liansuo.stations.station import Station
 from liansuo.stations.validation import validate
 
@@ -69,7 +68,7 @@ class ScenarioLog:
 def station_of(sc: Scenario) -> Station:
     """The scenario's station: a bundled name, or a path relative to the scenario's folder (from wherever the
     scenario is run); :class:`StationError` when it does not load."""
-    return load(resolve_from(sc.station, sc.file))
+    return load_named(sc.station, sc.file)
 
 
 def run_scenario(sc: Scenario, until_s: float | None = None, out: list[str] | None = None,

@@ -30,8 +30,7 @@ from liansuo.proving.fileschemas import ScriptFile
 from liansuo.proving.keywords import Expression
 from liansuo.proving.oracle import Watch
 from liansuo.simulation.sim import LANGUAGE, Simulation
-from liansuo.stations.library import resolve_from
-from liansuo.stations.loader import load
+from liansuo.stations.loader import load_named
 from liansuo.stations.station import Station
 from liansuo.stations.validation import validate
 
@@ -130,7 +129,7 @@ def _same_names(src: Source, names: list[str]) -> list[Diagnostic]:
 def script_station(script: Script) -> Station:
     """The station the script runs on: a bundled name, or a path relative to the script's folder (from wherever the
     script is run); :class:`StationError` when it does not load."""
-    return load(resolve_from(script.station, script.file))
+    return load_named(script.station, script.file)
 
 
 def selected(script: Script, only: str | None) -> list[ScriptTest]:

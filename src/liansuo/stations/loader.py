@@ -12,12 +12,13 @@ from pathlib import Path
 
 from pydantic import ValidationError
 
-from liansuo.kit.filekind import check_kind, read_source
-from liansuo.kit.source import Source, StationError, read_yaml
+from liansuo.kit.filekind import HOLDS, check_kind, kind_of_data, read_source
+from liansuo.kit.printable import printable
+from liansuo.kit.source import Diagnostic, Source, StationError, read_yaml
 from liansuo.rules import RuleSet
 from liansuo.stations.checks import cross_check
 from liansuo.stations.doubleslip import double_slip_errors, expand_double_slips
-from liansuo.stations.library import resolve
+from liansuo.stations.library import bundled, resolve, resolve_from
 from liansuo.stations.rules import design_warnings
 from liansuo.stations.schema import StationFile
 from liansuo.stations.station import Station
@@ -56,3 +57,20 @@ def load(name_or_path: str | Path, *, rules: RuleSet | None = None) -> Station:
     path = resolve(name_or_path)
     return parse_source(read_source(path, "station", "give a bundled station name (see 'liansuo stations') or a "
                                     "path"), rules)
+
+
+def load_named(name: str, named_in: str | Path, *, rules: RuleSet | None = None) -> Station:
+    """The station a script, a scenario or an exercise names with ``station:`` (a bundled name, or a path relative to
+    the file naming it). A file there that is no station file at all (none of a station's keys) is refused in one
+    line at the naming file, none of its content quoted: a file handed over may name any file on the machine as its
+    station, and the diagnostics of a station file would show its keys."""
+    if name in bundled():
+        return load(name, rules=rules)
+    path = resolve_from(name, named_in)
+    src = read_source(path, "station", "give a bundled station name (see 'liansuo stations') or a path relative to "
+                      f"{printable(str(named_in))}")
+    if kind_of_data(src.data) != "station":
+        raise StationError([Diagnostic(str(named_in), 1, 1, f"its station {printable(name)} is not a station file, so "
+                                       "nothing of it is shown", f"a station file has {HOLDS['station']}; name a "
+                                       "bundled station or a station file")])
+    return parse_source(src, rules)
