@@ -4,7 +4,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: run test lint clean native test-native docs
+.PHONY: run test test-lowest test-newest lint clean native test-native docs
 
 # Reinstall only when pyproject.toml or setup.py changed since the last install. The sumo extra (libsumo,
 # eclipse-sumo, about 230 MB) is installed too where it can be; where it cannot, the SUMO engine's tests skip and say
@@ -29,6 +29,17 @@ test: $(STAMP)
 # The documentation site with the API reference from the docstrings (mkdocs.yml), into site/.
 docs: $(STAMP)
 	$(BIN)/mkdocs build --strict
+
+# The wheel in a fresh environment outside the checkout (tests/test_wheel.py), its dependencies installed by uv at the
+# lowest versions pyproject.toml allows (lowest-direct: each at its floor, on Python 3.11, which uv fetches if it is
+# not here) or at the newest: the floors stay true (README.md, "Dependencies").
+test-lowest: $(STAMP)
+	$(BIN)/python -m pip install --quiet uv
+	LIANSUO_WHEEL_RESOLUTION=lowest-direct $(BIN)/python -m pytest -p no:cacheprovider -m wheel tests/test_wheel.py
+
+test-newest: $(STAMP)
+	$(BIN)/python -m pip install --quiet uv
+	LIANSUO_WHEEL_RESOLUTION=highest $(BIN)/python -m pytest -p no:cacheprovider -m wheel tests/test_wheel.py
 
 # The hot path compiled with mypyc (setup.py, docs/native.md): about 1.5-2x faster, the same results. Needs a C
 # compiler and Python's headers; `make clean` goes back to pure Python. `make test` runs the suite on the pure

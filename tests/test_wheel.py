@@ -4,17 +4,23 @@ environment outside the checkout, and run from another folder with no PYTHONPATH
 The rest of the suite runs against the editable install, where the checkout itself is on ``sys.path``: a data file
 missing from ``[tool.setuptools.package-data]``, a layer folder without ``__init__.py`` or a top-level package that
 should not be installed would all pass there and break ``pip install liansuo``. Here the installed ``liansuo`` runs
-``verify``, a route-test script, ``table``, the Python API, a bundled exercise, the console headless, the pytest
-plugin, ``--version``, ``completion``, the shipped JSON Schemas and ``--plot`` without the ``plot`` extra; a failure
-names the command that failed, its folder, exit status, stdout and stderr.
+``verify`` (also on Dask workers), a route-test script, ``table``, the Python API, a bundled exercise, the console
+headless, ``serve --web`` (a trainee, the instructor and a browser's console), the pytest plugin, ``--version``,
+``completion``, the shipped JSON Schemas and ``--plot`` without the ``plot`` extra; a failure names the command that
+failed, its folder, exit status, stdout and stderr.
 
-One build and one virtual environment serve every test of a run (a session fixture; some 20 s of CPU in all). Select
-with ``pytest -m wheel``, leave out with ``-m 'not wheel'``. The only skip: no package index is reachable and pip's
-cache lacks a requirement, so the wheel can be neither built nor installed.
+pip installs the newest dependencies. With ``LIANSUO_WHEEL_RESOLUTION=lowest-direct`` (``make test-lowest``) uv
+installs each at the floor pyproject.toml gives it, on the oldest Python it allows, and a test checks that every
+floor is what got installed; with ``highest`` (``make test-newest``) uv installs the newest.
+
+One build and one virtual environment serve every test of a run (a session fixture; some 25 s of CPU in all). Select
+with ``pytest -m wheel``, leave out with ``-m 'not wheel'``. The skips: no package index is reachable and pip's cache
+lacks a requirement, so the wheel can be neither built nor installed; the floors' test but under lowest-direct.
 """
 
 from __future__ import annotations
 
+import importlib.util
 import json
 import os
 import re
@@ -41,6 +47,9 @@ NOT_COPIED = {"__pycache__", ".pytest_cache", ".mypy_cache", ".ruff_cache", ".hy
 # environment variables that would let the installed package see the checkout or another environment
 DROPPED_ENV = {"PYTHONPATH", "PYTHONHOME", "PYTHONSTARTUP", "VIRTUAL_ENV", "PYTHONUSERBASE"}
 TAIL = 60  # lines of stdout and stderr shown when a command fails
+# `lowest-direct` or `highest`: install with uv (python -m uv) at that resolution of the dependencies pyproject.toml
+# declares, instead of with pip (make test-lowest, make test-newest); lowest-direct puts each at its floor
+RESOLUTION = os.environ.get("LIANSUO_WHEEL_RESOLUTION", "")
 
 ROUTE_SCRIPT = """\
 station: jiaopei
@@ -137,6 +146,51 @@ async def main():
 
 
 asyncio.run(main())
+"""
+
+# The classroom as tests/test_classroom_server.py serves it, with the browsers' console (textual-serve): a trainee and
+# the instructor over websockets, then a browser's terminal, whose console must draw its login dialog.
+SERVE_CHECK = """\
+import os
+import re
+import subprocess
+import sys
+import time
+
+from websockets.sync.client import connect
+
+from liansuo.server.client import ClassroomClient
+
+env = dict(os.environ, LIANSUO_INSTRUCTOR_PASSWORD="correct horse")
+proc = subprocess.Popen([sys.argv[1], "serve", "--port", "0", "--web", "--web-port", "0"], stdout=subprocess.PIPE,
+                        stdin=subprocess.DEVNULL, text=True, env=env)
+try:
+    first = proc.stdout.readline()
+    print(first.strip())
+    ws = first.split(" on ")[1].split(",")[0]
+    http = first.split("browsers on ")[1].split()[0]
+    with ClassroomClient.trainee(ws, seat=1, name="Li") as li:
+        print("trainee", li.command("route X XI")["message"])
+    with ClassroomClient.instructor(ws, "correct horse") as teacher:
+        print("instructor", teacher.command("fault broken-rail IG", seat=2)["message"])
+    screen = ""
+    deadline = time.monotonic() + 60
+    while "Log in to the classroom" not in screen and time.monotonic() < deadline:
+        try:  # the browsers' server starts a moment after the classroom's
+            with connect(http.replace("http:", "ws:") + "/ws?width=100&height=30", open_timeout=10) as browser:
+                while "Log in to the classroom" not in screen and time.monotonic() < deadline:
+                    try:
+                        data = browser.recv(timeout=1)
+                    except TimeoutError:
+                        continue
+                    screen += data if isinstance(data, str) else data.decode("utf-8", "replace")
+        except OSError:
+            time.sleep(0.3)
+    text = re.sub(r"\\x1b\\[[0-9;?]*[A-Za-z]", "", screen)
+    print("browser", "login dialog" if "Log in to the classroom" in text else "no login dialog in:\\n" + text[-3000:])
+finally:
+    proc.terminate()
+    proc.wait(10)
 """
 
 PLUGIN_MODULES_CHECK = """\
@@ -260,22 +314,48 @@ def install(tmp: Path) -> Installed:
     wheels = sorted(dist.glob("liansuo-*.whl"))
     assert len(wheels) == 1, f"pip wheel left {[w.name for w in dist.iterdir()]} in {dist}, expected one liansuo wheel"
     venv = tmp / "venv"
-    # without pip of its own: this pip installs into it (--python), which saves seconds and changes nothing installed
-    must("creating a fresh virtual environment", [sys.executable, "-m", "venv", "--without-pip", venv], tmp,
-         clean_env())
+    # pytest too, for the wheel's pytest11 entry point (at the test extra's floor under lowest-direct)
+    pytest_req = next(r for r in project["project"]["optional-dependencies"]["test"] if r.startswith("pytest>"))
+    args: list[str | Path]
+    if RESOLUTION:
+        uv = [sys.executable, "-m", "uv"] if importlib.util.find_spec("uv") else [shutil.which("uv") or ""]
+        if not uv[-1]:
+            pytest.fail(f"LIANSUO_WHEEL_RESOLUTION={RESOLUTION} installs with uv: pip install uv", pytrace=False)
+        # the lowest on the oldest Python requires-python allows, where every floor has wheels (uv finds that Python or
+        # fetches it); the newest on this one
+        python = project["project"]["requires-python"].removeprefix(">=") if RESOLUTION == "lowest-direct" \
+            else sys.executable
+        must(f"creating a fresh virtual environment (Python {python})", [*uv, "venv", "-q", "-p", python, venv], tmp,
+             clean_env())
+        # the dependencies named on the command line (-r pyproject.toml), so that lowest-direct resolves them to their
+        # floors: as the wheel's own dependencies they would be transitive, at their newest
+        args = [*uv, "pip", "install", "-q", "--python", venv / BIN / "python", "--resolution", RESOLUTION,
+                "-r", source / "pyproject.toml", wheels[0], pytest_req]
+    else:
+        # without pip of its own: this pip installs into it (--python), which saves seconds and changes nothing
+        # installed; bytecode is written as modules are first imported
+        must("creating a fresh virtual environment", [sys.executable, "-m", "venv", "--without-pip", venv], tmp,
+             clean_env())
+        args = [sys.executable, "-m", "pip", "--python", venv / BIN / "python", "install", "--no-compile",
+                "--no-warn-script-location", wheels[0], pytest_req]
     inst = Installed(wheels[0], source, venv, tmp / "work", clean_env(venv), built.stdout + built.stderr)
     inst.work.mkdir()
-    # pytest too, for the wheel's pytest11 entry point; bytecode is written as modules are first imported
-    build_or_skip("installed", [*inst.pip, "install", "--no-compile", "--no-warn-script-location", inst.wheel,
-                                "pytest"], tmp, inst.env, [*project["project"]["dependencies"], "pytest"], tmp)
-    # what the core install alone does, before the console extra joins it for the console's own test
-    inst.core = {name: run(args(inst), inst.work, inst.env) for name, args in CORE_RUNS.items()}
-    extras = project["project"]["optional-dependencies"]["console"]
-    build_or_skip("installed the console extra", [*inst.pip, "install", "--no-compile", "--no-warn-script-location",
-                                                   f"{inst.wheel}[console]"], tmp, inst.env, extras, tmp)
+    build_or_skip("installed", args, tmp, inst.env, [*project["project"]["dependencies"], pytest_req], tmp)
+    # what the core install alone does, before the extras join it for the console's, the classroom's and Dask's tests
+    inst.core = {name: run(command(inst), inst.work, inst.env) for name, command in CORE_RUNS.items()}
+    wanted = [f"{inst.wheel}[{','.join(EXTRAS)}]"]
+    if RESOLUTION:  # named on the command line, so that lowest-direct takes the extras' floors too
+        extra = [*uv, "pip", "install", "-q", "--python", venv / BIN / "python", "--resolution", RESOLUTION,
+                 "-r", source / "pyproject.toml", *(f"--extra={e}" for e in EXTRAS), *wanted]
+    else:
+        extra = [*inst.pip, "install", "--no-compile", "--no-warn-script-location", *wanted]
+    build_or_skip(f"installed the extras {', '.join(EXTRAS)}", extra, tmp, inst.env,
+                  [r for e in EXTRAS for r in project["project"]["optional-dependencies"][e]], tmp)
     return inst
 
 
+# the extras installed after the core's own runs, for the tests of the console, the classroom and Dask
+EXTRAS = ("console", "serve", "cluster")
 # commands run on the core install (no extra), by name: what is installed, and what needs an extra
 CORE_RUNS: dict[str, Callable[[Installed], list[str]]] = {
     "pip list": lambda i: [*i.pip, "list", "--format", "json"],
@@ -312,10 +392,36 @@ def test_the_build_prints_no_warning(installed: Installed) -> None:
     assert not warnings, "pip wheel printed warnings:\n" + installed.build_output
 
 
+def test_each_dependency_is_at_its_floor_under_the_lowest_resolution(installed: Installed) -> None:
+    """Under lowest-direct every dependency of pyproject.toml is installed at exactly the version its ``>=`` names: a
+    floor that another dependency's own floor lifts (textual needing a newer rich, say) is one no run ever tests."""
+    if RESOLUTION != "lowest-direct":
+        pytest.skip("the floors are installed only under LIANSUO_WHEEL_RESOLUTION=lowest-direct (make test-lowest)")
+    from packaging.requirements import Requirement
+    from packaging.utils import canonicalize_name
+    from packaging.version import Version
+
+    out = must("pip list", [*installed.pip, "list", "--format", "json"], installed.work, installed.env)
+    versions = {canonicalize_name(p["name"]): Version(p["version"]) for p in json.loads(out)}
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text("utf-8"))
+    wrong = []
+    declared = project["project"]["dependencies"] + [r for e in EXTRAS for r in project["project"][
+        "optional-dependencies"][e]]
+    for line in declared:
+        req = Requirement(line)
+        floors = [Version(s.version) for s in req.specifier if s.operator == ">="]
+        got = versions.get(canonicalize_name(req.name))
+        if floors and got != floors[0]:
+            wrong.append(f"{line}: {req.name} {got} installed")
+    assert not wrong, "the lowest resolution did not install these floors:\n  " + "\n  ".join(wrong)
+
+
 def test_verify_passes_on_the_bundled_station(installed: Installed) -> None:
-    out = must("liansuo verify jiaopei", [installed.liansuo, "verify", "jiaopei"], installed.work, installed.env)
-    last = out.strip().splitlines()[-1]
-    assert last.startswith("PASS:") and " 0 failures" in last, f"liansuo verify jiaopei ended with: {last}"
+    for workers in ([], ["--workers", "2"]):  # here, and fanned out on Dask's local worker processes
+        out = must(f"liansuo verify jiaopei {' '.join(workers)}", [installed.liansuo, "verify", "jiaopei", *workers],
+                   installed.work, installed.env)
+        last = out.strip().splitlines()[-1]
+        assert last.startswith("PASS:") and " 0 failures" in last, f"liansuo verify jiaopei ended with: {last}"
 
 
 def test_a_route_test_script_runs(installed: Installed) -> None:
@@ -362,6 +468,15 @@ def test_the_console_sets_a_route_headless(installed: Installed) -> None:
     for line in ("lamp X before ● #ff2020 red", "answer ✓ route X-XI selected", "route X-XI open",
                  "lamp X after ● #ffd700 yellow"):
         assert line in out, f"the console headless: no line {line!r} in\n{out}"
+
+
+def test_the_classroom_serves_trainees_the_instructor_and_browsers(installed: Installed) -> None:
+    script = installed.work / "serve_check.py"
+    script.write_text(SERVE_CHECK, encoding="utf-8")
+    out = must("liansuo serve --web (python serve_check.py)", [installed.python, script, installed.liansuo],
+               installed.work, installed.env)
+    for line in ("trainee route X-XI selected", "instructor fault injected: broken-rail IG", "browser login dialog"):
+        assert line in out, f"liansuo serve --web: no line {line!r} in\n{out}"
 
 
 def test_the_pytest_plugin_loads_light_and_runs_scripts(installed: Installed) -> None:
