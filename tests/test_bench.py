@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import math
 from collections import Counter
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
@@ -24,6 +25,13 @@ STATION_KEYS = {
     "busy_cycles", "cycle_us_busy", "realtime_factor", "busy_route_settings", "busy_traversals", "busy_stalls",
     "alarms", "peak_memory_mb",
 }
+CLASSROOM_KEYS = {
+    "station", "round_trips", "gap_ms", "memory_commands", "memory_line_chars", "memory_growth_kb", "memory_log_lines",
+    *(f"{case}_rtt_ms_{s}" for case in ("quiet", "flood", "login") for s in ("median", "p95", "max")),
+    "flood_sent", "flood_s", "flood_offered_per_s", "flood_read", "flood_read_per_s", "login_round_trips", "logins",
+    "logins_checked", "logins_locked_out", "logins_busy", "logins_failed", "logins_s",
+}
+NO_CLASSROOM = replace(Sizes.tiny(), classroom_round_trips=0)  # the command line's tests: no server to start
 POSITIVE = ("turnouts", "sections", "routes", "load_s", "table_build_s", "cycle_us_idle", "cycle_us_busy",
             "realtime_factor", "realtime_factor_idle", "busy_routes", "busy_traversals", "peak_memory_mb")
 
@@ -67,14 +75,39 @@ def test_report_has_every_figure_positive_and_finite(report: dict[str, object]) 
                           "met": trains["ratio_kinematic_to_sumo"] >= 5}]
 
 
+def test_the_classroom_under_attack_is_measured_and_every_attack_accounted_for(report: dict[str, object]) -> None:
+    """A real ``liansuo serve`` with a flooding client and a wave of wrong logins (bench/classroom.py): every figure
+    is there, and every message of the attacks is accounted for; the timings themselves are not judged."""
+    room = report["classroom"]
+    assert isinstance(room, dict)
+    assert set(room) == CLASSROOM_KEYS, room.get("skipped", room)
+    sizes = Sizes.tiny()
+    assert room["round_trips"] == sizes.classroom_round_trips and room["memory_commands"] == sizes.classroom_commands
+    for case in ("quiet", "flood", "login"):
+        median, p95, most = (room[f"{case}_rtt_ms_{s}"] for s in ("median", "p95", "max"))
+        assert 0 < median <= most and p95 <= most, (case, median, p95, most)
+    assert room["flood_sent"] > room["flood_read"] > 0  # the server read the flood at its own pace, not the client's
+    assert room["flood_offered_per_s"] > 0 and room["flood_s"] > 0
+    assert room["logins"] == sizes.classroom_logins == sum(
+        room[f"logins_{k}"] for k in ("checked", "locked_out", "busy", "failed"))
+    assert room["logins_failed"] == 0 and 1 <= room["logins_checked"] <= 5  # the lockout let at most 5 be checked
+    assert room["login_round_trips"] >= 1
+    assert room["memory_log_lines"] == 1000  # the seat's log at its bound
+    targets = report["targets"]
+    assert isinstance(targets, list)
+    assert {t["figure"] for t in targets if t["station"] == "classroom"} == {
+        "flood_rtt_ms_p95", "flood_offered_per_s", "login_rtt_ms_p95", "memory_growth_kb"}
+
+
 def test_text_format_lists_every_station(report: dict[str, object]) -> None:
     text = as_text(report)
     assert "hub20" in text and "jiaopei" in text and "cycle busy (us)" in text
+    assert "one client flooding" in text and "wrong logins at once" in text
 
 
 def test_cli_bench_prints_json(monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
     monkeypatch.setattr(bench, "run_bench",
-                        lambda quick=False, scale=None, show_progress=None: run_bench(Sizes.tiny(), quick=quick))
+                        lambda quick=False, scale=None, show_progress=None: run_bench(NO_CLASSROOM, quick=quick))
     assert main(["bench", "--quick"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["mode"] == "quick" and set(out["results"]) == {"hub", "jiaopei"}
@@ -85,7 +118,7 @@ def test_cli_bench_prints_json(monkeypatch: pytest.MonkeyPatch, capsys: pytest.C
 def test_each_run_asked_for_is_appended_to_the_history(monkeypatch: pytest.MonkeyPatch, tmp_path: Path,
                                                        capsys: pytest.CaptureFixture[str]) -> None:
     monkeypatch.setattr(bench, "run_bench",
-                        lambda quick=False, scale=None, show_progress=None: run_bench(Sizes.tiny(), quick=quick))
+                        lambda quick=False, scale=None, show_progress=None: run_bench(NO_CLASSROOM, quick=quick))
     history = tmp_path / "history.jsonl"
     for _ in range(2):
         assert main(["bench", "--quick", "--history", str(history)]) == 0

@@ -21,7 +21,8 @@ def cmd_bench(args: argparse.Namespace) -> int:
 
 
 def register(add: Add) -> None:
-    sp = add("bench", cmd_bench, "benchmark table building and the interlocking cycle (hub and jiaopei)")
+    sp = add("bench", cmd_bench, "benchmark table building and the interlocking cycle (hub and jiaopei), and the "
+             "classroom server under attack")
     sp.add_argument("--quick", action="store_true", help="fewer cycles (under a minute)")
     sp.add_argument("--format", choices=("json", "text"), default="json", help="json (default) or text")
     sp.add_argument("--explore", action="store_true", help="instead, the figures of 'liansuo explore': saturation, "

@@ -9,6 +9,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from liansuo.bench import classroom
 from liansuo.bench.busy import BUSY_ROUTES
 from liansuo.bench.field import measure_field
 from liansuo.bench.history import append
@@ -52,15 +53,22 @@ class Sizes:
     train_cycles: int = 4800  # trains moving on the hub, each engine (trains.py); 0 skips it
     train_slots: int = 10
     field_cycles: int = 2000  # jiaopei in field control against field-sim (field.py); 0 skips it
+    # the classroom under attack (classroom.py): honest round trips timed in each case (0 skips it all), commands
+    # sent to one seat for its memory, wrong instructor logins sent at once
+    classroom_round_trips: int = 200
+    classroom_commands: int = 100_000
+    classroom_logins: int = 500
 
     @staticmethod
     def quick() -> Sizes:
-        return Sizes(idle_cycles=1000, busy_cycles=2400, zpw_repeats=3, train_cycles=1200, field_cycles=400)
+        return Sizes(idle_cycles=1000, busy_cycles=2400, zpw_repeats=3, train_cycles=1200, field_cycles=400,
+                     classroom_round_trips=50, classroom_commands=10_000)
 
     @staticmethod
     def tiny() -> Sizes:
         return Sizes(hub_turnouts=20, hub_tracks=8, idle_cycles=20, busy_cycles=120, small_factor=1,
-                     warmup_limit=400, zpw_repeats=1, train_cycles=240, train_slots=2, field_cycles=0)
+                     warmup_limit=400, zpw_repeats=1, train_cycles=240, train_slots=2, field_cycles=0,
+                     classroom_round_trips=5, classroom_commands=1000, classroom_logins=20)
 
 
 def _check_targets(results: dict[str, dict[str, Any]]) -> list[dict[str, Any]]:
@@ -83,7 +91,7 @@ def run_bench(sizes: Sizes | None = None, *, quick: bool = False, stations: tupl
     also the figures of :mod:`.scale` (verify, soak and the table at hub size). ``show_progress``: a bar of the
     parts on stderr (None: when it is a terminal)."""
     sizes = sizes or (Sizes.quick() if quick else Sizes())
-    parts = len(stations) + 3 + (scale is not None)
+    parts = len(stations) + 4 + (scale is not None)
     with progress("bench", parts, show=show_progress) as advance:
         return _run(sizes, quick, stations, scale, advance)
 
@@ -112,6 +120,9 @@ def _run(sizes: Sizes, quick: bool, stations: tuple[str, ...], scale: ScaleSizes
     advance(1)
     field = measure_field(sizes.field_cycles) if sizes.field_cycles > 0 else None
     advance(1)
+    room = (classroom.measure_classroom(sizes.classroom_round_trips, sizes.classroom_commands,
+                                        sizes.classroom_logins) if sizes.classroom_round_trips > 0 else None)
+    advance(1)
     targets = _check_targets(results)
     targets.append({"station": "zpw", "figure": "zpw_configs_per_s", "target": f">= {ZPW_TARGET_CONFIGS_PER_S:g}",
                     "value": zpw["zpw_configs_per_s"], "met": zpw["zpw_configs_per_s"] >= ZPW_TARGET_CONFIGS_PER_S})
@@ -123,6 +134,8 @@ def _run(sizes: Sizes, quick: bool, stations: tuple[str, ...], scale: ScaleSizes
         if ratio is not None:  # SUMO ran beside it (without SUMO the trains figures say why not)
             targets.append({"station": trains["station"], "figure": "ratio_kinematic_to_sumo",
                             "target": f">= {TARGET_RATIO:g}", "value": ratio, "met": ratio >= TARGET_RATIO})
+    if room is not None:
+        targets += classroom.targets(room)
     return {
         "benchmark": "liansuo bench",
         "mode": "quick" if quick else ("custom" if sizes != Sizes() else "full"),
@@ -134,6 +147,7 @@ def _run(sizes: Sizes, quick: bool, stations: tuple[str, ...], scale: ScaleSizes
         "zpw": zpw,
         **({"trains": trains} if trains is not None else {}),
         **({"field": field} if field is not None else {}),
+        **({"classroom": room} if room is not None else {}),
         **({"scale": scaled} if scaled is not None else {}),
         "targets": targets + [{"station": "hub", **t} for t in (scaled or {}).get("targets", [])],
         "total_s": round(time.perf_counter() - start, 2),
@@ -193,6 +207,8 @@ def as_text(report: dict[str, Any]) -> str:
                      f"{f['field_cycles_per_s']:.0f} cycles/s on {f['station']} over {f['transport']} "
                      f"({f['field_cycle_ms']:.2f} ms a cycle, {f['realtime_factor_field']:.0f}x real time; simulated "
                      f"control {f['simulated_cycles_per_s']:.0f} cycles/s, {f['ratio_simulated_to_field']:.1f}x)"))
+    if report.get("classroom"):
+        lines += classroom.text(report["classroom"])
     sc = report.get("scale")
     if sc:
         lines.append("scale:")

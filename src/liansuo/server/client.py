@@ -73,6 +73,13 @@ class ClassroomClient:
             if msg.get("type") == "snapshot":
                 return msg
 
+    def seats(self) -> list[dict[str, Any]]:
+        """The next summary of every seat the server sends (the instructor's dashboard: trainee, commands, ...)."""
+        while True:
+            msg = self._next()
+            if msg.get("type") == "seats":
+                return list(msg["seats"])
+
     def close(self) -> None:
         self.ws.close()
 
