@@ -328,3 +328,17 @@ def test_a_guide_over_a_route_counts_only_what_lies_on_that_route() -> None:
     assert guide_cause(st, plant, "X", ["7DG", "1DG", "3DG", "5DG", "3G"])  # the route to 3G
     assert not guide_cause(st, plant, "X", ["7DG", "1DG", "IG"])  # the route to IG: 3G is no reason
     assert guide_cause(st, planted(st, ["fault no-indication 1"]), "X", ["7DG", "1DG", "IG"])  # 1 stands in 1DG
+
+
+def test_a_typo_is_told_as_one_and_costs_nothing_an_instructors_command_does() -> None:
+    """Issue 46, item 4: ``rout X XI`` on a trainee's seat was told it belongs to the instructor and counted as a
+    refused command, costing points; a word that is no command is a typo, with a suggestion, never counted."""
+    typo = attempt("jiaopei-cancel-route", [(1, "rout X XI"), (2, "xyzzy"), (3, "route 'X XI")])
+    answers = [c["answer"] for c in typo.report()["commands"]]
+    assert answers[0] == "unknown command 'rout'; did you mean 'route'? (a typo: not counted)"
+    assert "unknown command 'xyzzy'" in answers[1] and "a typo" in answers[1]
+    assert typo.report()["refused"] == 0
+    instructor = attempt("jiaopei-cancel-route", [(1, "fault broken-rail IG")])
+    assert instructor.report()["refused"] == 1
+    assert "belongs to the instructor" in instructor.report()["commands"][0]["answer"]
+    assert typo.report()["score"]["refused"] == 0 and instructor.report()["score"]["refused"] < 0

@@ -55,3 +55,14 @@ def test_a_trainees_quoted_instructor_command_is_refused(url: str) -> None:
             assert not answer["ok"], (line, answer)
             assert "instructor" in answer["message"] or "clock" in answer["message"], (line, answer)
         assert wang.command("'route' X XI")["ok"]  # an operator's command, quoted, is still one
+
+
+def test_a_trainees_typo_is_told_as_one_and_not_counted(url: str) -> None:
+    """Issue 46, item 4, over the wire: the seat's refused count, which the instructor's dashboard shows, takes no
+    typo; an instructor's command from the seat does count."""
+    with ClassroomClient.trainee(url, seat=1, name="Zhao") as zhao:
+        answer = zhao.command("rout X XI")
+        assert not answer["ok"] and answer["message"].startswith("unknown command 'rout'; did you mean 'route'?")
+        assert not zhao.command("fault broken-rail IG")["ok"]
+    with ClassroomClient.instructor(url, PASSWORD) as teacher:
+        assert teacher.seats()[0]["refused"] == 1  # the instructor's command only

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from liansuo.classroom.exercise import DIFFICULTIES, Exercise, check_goal
-from liansuo.classroom.roles import command_word
+from liansuo.classroom.roles import command_word, is_typo
 from liansuo.classroom.score import ScoreInputs, score
 from liansuo.classroom.unsafe import (
     RED_BAND,
@@ -189,7 +189,7 @@ class Assessment:
         t = round(self.sim.t - self.start, 3)
         self._observe()
         self.commands += 1
-        self.refused += not result.ok
+        self.refused += not result.ok and not is_typo(line)  # a typo costs nothing
         if len(self.entries) < KEPT:
             self.entries.append(Entry(t, line.strip(), result.ok, result.message))
         if result.ok:

@@ -11,8 +11,11 @@ instructor's panel is closed.
 
 from __future__ import annotations
 
+from difflib import get_close_matches
+
 from liansuo.interlocking.io import Result
-from liansuo.simulation.language import command_name
+from liansuo.simulation.language import command_name, parse_line
+from liansuo.simulation.sim import LANGUAGE
 
 # The commands of a CBI operator console (操作表示机), as the command language names them.
 OPERATOR_COMMANDS = frozenset({
@@ -32,8 +35,34 @@ def command_word(line: str) -> str:
     return command_name(line)
 
 
+def is_typo(line: str) -> bool:
+    """Whether ``line`` names no command at all (an unknown word, or a line the language cannot read): a slip of the
+    keyboard, which an exercise never counts as a refused command."""
+    try:
+        words = parse_line(line)
+    except ValueError:
+        return True
+    return bool(words) and words[0] not in LANGUAGE
+
+
+def typo(role: str, line: str) -> Result | None:
+    """The refusal of a line that names no command, with the closest commands ``role`` has; None for a command."""
+    if not is_typo(line):
+        return None
+    word = command_word(line)
+    if not word:
+        return None  # unreadable: the language says why
+    mine = sorted(OPERATOR_COMMANDS) if role != INSTRUCTOR else sorted(LANGUAGE)
+    close = get_close_matches(word, mine, n=2, cutoff=0.6)
+    hint = f"; did you mean {' or '.join(repr(c) for c in close)}?" if close else f"; commands: {', '.join(mine)}"
+    return Result.refuse(f"unknown command '{word}'{hint} (a typo: not counted)")
+
+
 def refusal(role: str, line: str) -> Result | None:
-    """None when ``role`` may send ``line``; otherwise the refusal, in the signaller's terms."""
+    """None when ``role`` may send ``line``; otherwise the refusal, in the signaller's terms: a typo is told as one
+    (:func:`typo`), an instructor's command from a trainee as the instructor's."""
+    if (no := typo(role, line)) is not None:
+        return no
     if role == INSTRUCTOR:
         return None
     word = command_word(line)

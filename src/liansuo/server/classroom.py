@@ -21,7 +21,7 @@ from typing import Any
 from liansuo.classroom.assessment import Assessment, ExerciseSetupError
 from liansuo.classroom.exercise import DIFFICULTIES, bundled_exercises, parse_exercise
 from liansuo.classroom.report import write_report
-from liansuo.classroom.roles import INSTRUCTOR, command_word, refusal
+from liansuo.classroom.roles import INSTRUCTOR, command_word, is_typo, refusal
 from liansuo.classroom.snapshot import EventCursor, snapshot
 from liansuo.interlocking.io import Result
 from liansuo.kit.source import StationError
@@ -198,7 +198,7 @@ class Classroom:
         result = no if no is not None else s.sim.command(line)
         if role != INSTRUCTOR:
             s.commands += 1
-            s.refused += not result.ok
+            s.refused += not result.ok and not is_typo(line)  # a typo is not a refused command
         a = s.desk.assessment
         if role != INSTRUCTOR and a is not None and not a.finished:
             a.record(line, result)
