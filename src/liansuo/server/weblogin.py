@@ -139,6 +139,3 @@ class Desk:
             locked = self.guard.end(address, ok, time.monotonic())
         if not ok:
             raise Refused(f"wrong instructor password{f': {locked}' if locked else ''}")
-
-    def close(self) -> None:
-        self._hasher.shutdown(wait=False)
