@@ -88,6 +88,20 @@ class Browser:
         self.call("Input.dispatchKeyEvent", type="keyUp", key=key, code=code, windowsVirtualKeyCode=vk)
         time.sleep(0.05)
 
+    def log_in(self, url: str, **fields: str) -> None:
+        """Open the classroom's page and submit its login form (``name`` and ``seat``, or ``password``) as a user
+        fills it in; textual-serve's page with the console follows once the server accepts."""
+        self.open(url)
+        end = time.monotonic() + 30
+        while not self.evaluate("!!document.querySelector('form[action=login]')"):
+            if time.monotonic() > end:
+                raise RuntimeError(f"no login form at {url}")
+            time.sleep(0.2)
+        role = "instructor" if "password" in fields else "trainee"
+        fill = "".join(f"document.querySelector('#{k}').value = {json.dumps(v)};" for k, v in fields.items())
+        self.evaluate(f"document.querySelector('input[value={role}]').checked = true; {fill}"
+                      "document.querySelector('form[action=login]').submit()")
+
     def screenshot(self, path: Path) -> None:
         data = self.call("Page.captureScreenshot", format="png")["data"]
         path.write_bytes(base64.b64decode(data))

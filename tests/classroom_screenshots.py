@@ -44,22 +44,15 @@ def main(out: Path) -> None:
             proc.wait(10)
 
 
-def login(browser: Browser, web: str, *keys: str) -> None:
-    browser.open(web)
-    time.sleep(8)
-    browser.focus(TEXTAREA)
-    for k in keys:
-        browser.press(k) if k in ("Tab", "Enter") else browser.type(k)
-
-
 def shoot(ws: str, web: str, out: Path) -> None:
     with ClassroomClient.trainee(ws, seat=2, name="Wang"):
         with Browser(1400, 900) as li:
-            login(li, web, "Li Lei", "Tab", "1")
-            time.sleep(1)
+            li.open(web)
+            time.sleep(2)
+            li.evaluate("document.querySelector('#name').value = 'Li Lei'; document.querySelector('#seat').value = 1")
             li.screenshot(out / "classroom-login.png")
-            li.press("Enter")
-            time.sleep(4)
+            li.log_in(web, name="Li Lei", seat="1")
+            time.sleep(8)
             with ClassroomClient.instructor(ws, PASSWORD) as teacher:
                 teacher.request({"type": "exercise", "seats": [1], "name": "jiaopei-cancel-route", "seed": 1})
             time.sleep(3)
@@ -74,8 +67,8 @@ def shoot(ws: str, web: str, out: Path) -> None:
         with ClassroomClient.instructor(ws, PASSWORD) as teacher:
             teacher.request({"type": "exercise", "seats": [2], "name": "jiaopei-filament", "seed": 3})
         with Browser(1400, 600) as tab:
-            login(tab, web, "Tab", "Tab", PASSWORD, "Enter")  # name, seat, the password: the instructor
-            time.sleep(5)
+            tab.log_in(web, password=PASSWORD)  # the instructor
+            time.sleep(8)
             tab.screenshot(out / "classroom-dashboard.png")
 
 

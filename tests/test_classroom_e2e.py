@@ -141,25 +141,13 @@ TEXTAREA = "textarea.xterm-helper-textarea"  # where the page's terminal takes t
 
 
 def log_in(browser: Browser, web: str, teacher: ClassroomClient, name: str, seat: int) -> None:
-    """Open the page and log in as a trainee; again, on a fresh page, if a loaded machine lost the keys."""
-    for attempt in range(3):
-        browser.open(web)
-        # the page marks its body once the client process draws (it has asked the server's lobby by then)
-        until(lambda: bool(browser.evaluate("document.body.classList.contains('-first-byte')")), 60,
-              "the console drawing on the page")
-        time.sleep(2.0 + 2.0 * attempt)  # the login screen over it
-        browser.focus(TEXTAREA)
-        browser.type(name)
-        browser.press("Tab")
-        browser.type(str(seat))
-        browser.press("Enter")
-        try:
-            until(lambda: seat_of(teacher, seat)["connected"] and seat_of(teacher, seat)["trainee"] == name, 20,
-                  f"{name} at seat {seat} from the browser")
-            return
-        except AssertionError:
-            if attempt == 2:
-                raise
+    """Log in as a trainee on the page, whose console then opens at the seat."""
+    browser.log_in(web, name=name, seat=str(seat))
+    # the page marks its body once the console process draws (started after the login, at the seat)
+    until(lambda: bool(browser.evaluate("document.body.classList.contains('-first-byte')")), 60,
+          "the console drawing on the page")
+    until(lambda: seat_of(teacher, seat)["connected"] and seat_of(teacher, seat)["trainee"] == name, 20,
+          f"{name} at seat {seat} from the browser")
 
 
 @pytest.mark.skipif(chromium() is None, reason="no Chromium on this machine (Debian: apt-get install chromium): the "

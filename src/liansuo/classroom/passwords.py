@@ -11,6 +11,7 @@ import secrets
 from pathlib import Path
 
 ENV = "LIANSUO_INSTRUCTOR_PASSWORD"
+TOKEN_ENV = "LIANSUO_SEAT_TOKEN"  # a seat's token, to take it back (a browser's console is started with it)
 CHANGEOVER_ENV = "LIANSUO_CHANGEOVER_PASSWORD"  # QHA, the change-over to field control (docs/field-mode.md)
 N, R, P = 2**14, 8, 1  # scrypt's cost: about 20 ms and 16 MB a check
 

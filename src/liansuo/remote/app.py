@@ -59,7 +59,7 @@ class RemoteConsoleApp(ConsoleApp):
         self.remote.step()
         self.refresh_views()
         if not isinstance(self.link, ServerLink):
-            self.push_screen(LoginScreen(self.link.url, self.link.lobby), self.logged)
+            self.push_screen(LoginScreen(self.link.url, self.link.lobby, self.link.tls), self.logged)
             return
         self.greet()
 

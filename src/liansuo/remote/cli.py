@@ -12,7 +12,7 @@ import os
 from pathlib import Path
 from typing import Any
 
-from liansuo.classroom.passwords import ENV
+from liansuo.classroom.passwords import ENV, TOKEN_ENV
 from liansuo.kit.exitcodes import Exit, refuse
 
 
@@ -49,22 +49,26 @@ def hello(args: argparse.Namespace) -> dict[str, Any] | None:
         return None
     if not 1 <= args.seat <= 64:
         raise LoginError(f"--seat is 1 to 64, not {args.seat}")
-    return {"role": "trainee", "seat": args.seat, "name": args.name or os.environ.get("USER", "")}
+    return {"role": "trainee", "seat": args.seat, "name": args.name or os.environ.get("USER", ""),
+            "token": os.environ.get(TOKEN_ENV) or None}
 
 
 def cmd_connect(args: argparse.Namespace) -> int:
     from liansuo.remote.link import LinkError, ServerLink, Unlinked, lobby
+    from liansuo.server.tls import TLSError, client_context
     from liansuo.tui.cli import closed
 
     try:
         greeting = hello(args)
         if not args.connect.startswith(("ws://", "wss://")):
-            raise LoginError(f"--connect takes a websocket address, ws://HOST:PORT, not {args.connect!r}")
-    except LoginError as exc:
+            raise LoginError(f"--connect takes a websocket address, ws://HOST:PORT or wss://HOST:PORT, not "
+                             f"{args.connect!r}")
+        tls = client_context(args.connect, args.cafile)
+    except (LoginError, TLSError) as exc:
         return refuse("tui", str(exc), Exit.USAGE)
     try:
-        link: ServerLink | Unlinked = Unlinked(args.connect, lobby(args.connect)) if greeting is None \
-            else ServerLink(args.connect, greeting)
+        link: ServerLink | Unlinked = Unlinked(args.connect, lobby(args.connect, tls=tls), tls) if greeting is None \
+            else ServerLink(args.connect, greeting, tls=tls)
     except LinkError as exc:
         return refuse("tui", str(exc), Exit.USAGE)
     from liansuo.remote.app import RemoteConsoleApp

@@ -11,6 +11,7 @@ the console closes.
 from __future__ import annotations
 
 import json
+import ssl
 import threading
 import time
 from collections import deque
@@ -19,6 +20,8 @@ from typing import Any
 
 from websockets.exceptions import ConnectionClosed, InvalidURI, WebSocketException
 from websockets.sync.client import ClientConnection, connect
+
+from liansuo.server.tls import hint
 
 REQUEST_TIMEOUT_S = 5.0  # a reply slower than this is answered "no answer" (the console does not freeze longer)
 OPEN_TIMEOUT_S = 5.0
@@ -35,14 +38,18 @@ class _Waiting:
     reply: dict[str, Any] | None = None
 
 
-def dial(url: str, hello: dict[str, Any], timeout: float = OPEN_TIMEOUT_S) -> tuple[ClientConnection, dict[str, Any]]:
-    """Connect and say hello; the connection and the server's welcome, or :class:`LinkError` saying why not."""
+def dial(url: str, hello: dict[str, Any], timeout: float = OPEN_TIMEOUT_S, *,
+         tls: ssl.SSLContext | None = None) -> tuple[ClientConnection, dict[str, Any]]:
+    """Connect and say hello; the connection and the server's welcome, or :class:`LinkError` saying why not.
+    ``tls``: how a wss:// server is verified (server/tls.py; None: against the system's CAs)."""
     try:
-        ws = connect(url, open_timeout=timeout, close_timeout=1).__enter__()  # closed by Link.close()
+        ws = connect(url, open_timeout=timeout, close_timeout=1, ssl=tls).__enter__()  # closed by Link.close()
+    except ssl.SSLError as exc:  # a certificate refused is a ValueError too
+        raise LinkError(f"cannot reach the classroom server at {url}: {exc}{hint(url, exc)}") from None
     except (InvalidURI, ValueError) as exc:
         raise LinkError(f"{url} is not a websocket address (ws://HOST:PORT): {exc}") from None
     except (OSError, TimeoutError, WebSocketException) as exc:
-        raise LinkError(f"cannot reach the classroom server at {url}: {exc}") from None
+        raise LinkError(f"cannot reach the classroom server at {url}: {exc}{hint(url, exc)}") from None
     try:
         ws.send(json.dumps({"type": "hello", **hello}))
         reply = json.loads(ws.recv(timeout=timeout))
@@ -59,11 +66,13 @@ def dial(url: str, hello: dict[str, Any], timeout: float = OPEN_TIMEOUT_S) -> tu
 class ServerLink:
     """A console's connection to the server (see the module's docstring). Thread-safe; never raises once open."""
 
-    def __init__(self, url: str, hello: dict[str, Any], *, timeout: float = REQUEST_TIMEOUT_S) -> None:
+    def __init__(self, url: str, hello: dict[str, Any], *, timeout: float = REQUEST_TIMEOUT_S,
+                 tls: ssl.SSLContext | None = None) -> None:
         self.url = url
         self.timeout = timeout
+        self.tls = tls
         self._hello = dict(hello)
-        self._ws, self.welcome = dial(url, self._hello)
+        self._ws, self.welcome = dial(url, self._hello, tls=tls)
         if self.welcome.get("token"):
             self._hello["token"] = self.welcome["token"]
         self.seat = int(self.welcome.get("seat") or 1)  # the trainee's seat, or the seat the instructor watches
@@ -181,7 +190,7 @@ class ServerLink:
         while not self._closing:
             time.sleep(REDIAL_S)
             try:
-                ws, welcome = dial(self.url, self._hello)
+                ws, welcome = dial(self.url, self._hello, tls=self.tls)
             except LinkError as exc:
                 self.problem = str(exc)
                 continue
@@ -199,17 +208,19 @@ class ServerLink:
             return
 
 
-def lobby(url: str, timeout: float = OPEN_TIMEOUT_S) -> dict[str, Any]:
+def lobby(url: str, timeout: float = OPEN_TIMEOUT_S, *, tls: ssl.SSLContext | None = None) -> dict[str, Any]:
     """What the server tells before a login: its station, cycle and seats (who sits where); :class:`LinkError`
     when it cannot be asked."""
     try:
-        with connect(url, open_timeout=timeout, close_timeout=1) as ws:
+        with connect(url, open_timeout=timeout, close_timeout=1, ssl=tls) as ws:
             ws.send(json.dumps({"type": "lobby"}))
             reply = json.loads(ws.recv(timeout=timeout))
+    except ssl.SSLError as exc:  # a certificate refused is a ValueError too
+        raise LinkError(f"cannot reach the classroom server at {url}: {exc}{hint(url, exc)}") from None
     except (InvalidURI, ValueError) as exc:
         raise LinkError(f"{url} is not a websocket address (ws://HOST:PORT): {exc}") from None
     except (OSError, TimeoutError, WebSocketException) as exc:
-        raise LinkError(f"cannot reach the classroom server at {url}: {exc}") from None
+        raise LinkError(f"cannot reach the classroom server at {url}: {exc}{hint(url, exc)}") from None
     if not isinstance(reply, dict) or reply.get("type") != "lobby":
         why = reply.get("message", reply) if isinstance(reply, dict) else reply
         raise LinkError(f"the classroom server at {url} did not answer as one: {why}")
@@ -226,9 +237,10 @@ class Unlinked:
     seat = 0
     problem = "not logged in"
 
-    def __init__(self, url: str, lobby: dict[str, Any]) -> None:
+    def __init__(self, url: str, lobby: dict[str, Any], tls: ssl.SSLContext | None = None) -> None:
         self.url = url
         self.lobby = lobby
+        self.tls = tls
         self.welcome = {"station": lobby.get("station") or {}, "cycle_s": lobby.get("cycle_s", 0.25)}
 
     def take(self) -> tuple[dict[str, Any] | None, list[list[Any]]]:

@@ -7,6 +7,7 @@ app of its own: textual-serve ends a browser's session when its process's first 
 
 from __future__ import annotations
 
+import ssl
 from typing import Any, ClassVar
 
 from rich.text import Text
@@ -53,10 +54,11 @@ class LoginScreen(ModalScreen[ServerLink | None]):
     """
     BINDINGS: ClassVar[list[BindingType]] = [Binding("ctrl+q", "leave", "quit")]
 
-    def __init__(self, url: str, lobby: dict[str, Any]) -> None:
+    def __init__(self, url: str, lobby: dict[str, Any], tls: ssl.SSLContext | None = None) -> None:
         super().__init__()
         self.url = url
         self.lobby = lobby
+        self.tls = tls
 
     def compose(self) -> ComposeResult:
         station = str((self.lobby.get("station") or {}).get("name", ""))
@@ -108,7 +110,7 @@ class LoginScreen(ModalScreen[ServerLink | None]):
     @work(thread=True, exclusive=True)
     def dial(self, hello: dict[str, Any]) -> None:
         try:
-            link = ServerLink(self.url, hello)
+            link = ServerLink(self.url, hello, tls=self.tls)
         except LinkError as exc:
             self.app.call_from_thread(self.show, str(exc))
             return

@@ -7,8 +7,10 @@ import asyncio
 import getpass
 import signal
 import socket
+import ssl
 import sys
 from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -47,6 +49,13 @@ def register(add: Add) -> None:
     sp.add_argument("--public-url", metavar="URL",
                     help="with --web: the address browsers use to reach this machine, when it is not "
                          "http://HOST:PORT (behind a proxy, or --host 0.0.0.0)")
+    sp.add_argument("--web-consoles", type=int, metavar="N",
+                    help="with --web: at most N browser consoles at once, each a process of about 90 MB started "
+                         "after a login (default: the seats and 4 more)")
+    sp.add_argument("--certfile", metavar="FILE",
+                    help="TLS: the server's certificate (PEM; its CA's after it), so that clients connect to wss:// "
+                         "and browsers to https://; with --keyfile")
+    sp.add_argument("--keyfile", metavar="FILE", help="TLS: the certificate's private key (PEM), with --certfile")
     sp.add_argument("--lockout", type=float, default=60.0, metavar="S",
                     help="after 5 wrong instructor passwords from one address, refuse it for S seconds, twice as long "
                          "at each lockout after (default 60, at most 3600)")
@@ -69,13 +78,28 @@ def cmd_serve(args: argparse.Namespace) -> int:
             return refuse("serve", f"{name} is 0 to 65535, not {port}", Exit.USAGE)
     if not 0 <= args.lockout <= 3600:
         return refuse("serve", f"--lockout is 0 to 3600 seconds, not {args.lockout:g}", Exit.USAGE)
+    scheme = "https" if args.certfile else "http"
     if args.web and args.public_url is None and args.host in ("0.0.0.0", "::", ""):
-        return refuse("serve", f"with --host {args.host} and --web, give --public-url http://ADDRESS:{args.web_port} "
-                      "(this machine's address as the classroom's browsers reach it): the page tells them where to "
-                      "connect", Exit.USAGE)
-    if args.public_url is not None and not args.public_url.startswith(("http://", "https://")):
-        return refuse("serve", f"--public-url is an http:// or https:// address, not {args.public_url!r}",
-                      Exit.USAGE)
+        return refuse("serve", f"with --host {args.host} and --web, give --public-url {scheme}://ADDRESS:"
+                      f"{args.web_port} (this machine's address as the classroom's browsers reach it): the page tells "
+                      "them where to connect", Exit.USAGE)
+    schemes = ("https://",) if args.certfile else ("http://", "https://")  # https:// also behind a TLS proxy
+    if args.public_url is not None and not args.public_url.startswith(schemes):
+        kind = "an https:// address (with --certfile)" if args.certfile else "an http:// or https:// address"
+        return refuse("serve", f"--public-url is {kind}, not {args.public_url!r}", Exit.USAGE)
+    consoles = args.seats + 4 if args.web_consoles is None else args.web_consoles
+    if not 1 <= consoles <= 256:
+        return refuse("serve", f"--web-consoles is 1 to 256, not {consoles}", Exit.USAGE)
+    if (args.certfile is None) != (args.keyfile is None):
+        return refuse("serve", "TLS needs both --certfile and --keyfile", Exit.USAGE)
+    tls = None
+    if args.certfile is not None:
+        from liansuo.server.tls import TLSError, server_context
+
+        try:
+            tls = server_context(args.certfile, args.keyfile)
+        except TLSError as exc:
+            return refuse("serve", str(exc), Exit.USAGE)
     try:
         stored = instructor_hash(args.password_file)
     except PasswordError as exc:
@@ -102,8 +126,10 @@ def cmd_serve(args: argparse.Namespace) -> int:
             classroom.close()
             return refuse("serve", f"cannot serve browsers on {args.host}:{args.web_port}: {exc.strerror or exc}",
                           Exit.USAGE)
+    web = None if web_port is None else WebPlan(web_port, args.public_url, stored, args.lockout, consoles,
+                                                args.certfile, args.keyfile)
     try:
-        asyncio.run(_serve(server, args.host, args.port, web_port, args.public_url))
+        asyncio.run(_serve(server, args.host, args.port, web, tls))
     except OSError as exc:
         return refuse("serve", f"cannot listen on {args.host}:{args.port}: {exc.strerror or exc}", Exit.USAGE)
     except (KeyboardInterrupt, asyncio.CancelledError):
@@ -121,24 +147,42 @@ def _free(host: str, port: int) -> int:
         return int(s.getsockname()[1])
 
 
-async def _serve(server: ClassroomServer, host: str, port: int, web_port: int | None, public_url: str | None) -> None:
+@dataclass(frozen=True)
+class WebPlan:
+    """What the browsers' server is given besides the classroom server's address (``server/web.py``)."""
+
+    port: int
+    public_url: str | None
+    instructor_hash: str
+    lockout_s: float
+    consoles: int
+    certfile: str | None
+    keyfile: str | None
+
+
+async def _serve(server: ClassroomServer, host: str, port: int, plan: WebPlan | None,
+                 tls: ssl.SSLContext | None) -> None:
     ready: asyncio.Future[int] = asyncio.get_running_loop().create_future()
-    task = asyncio.create_task(server.serve(host, port, ready))
+    task = asyncio.create_task(server.serve(host, port, ready, tls))
     asyncio.get_running_loop().add_signal_handler(signal.SIGTERM, task.cancel)  # kill: stop as ctrl+c does
     while not ready.done():  # listening, or the task ended: the OSError of a port it could not listen on goes up
         if task.done():
             task.result()
         await asyncio.sleep(0.01)
     seats = len(server.classroom.seats)
+    scheme = "wss" if tls else "ws"
     browsers = ""
     web = None
-    if web_port is not None:
+    if plan is not None:
         from liansuo.server import web as webserver
 
-        web = webserver.start(webserver.local_url(host, ready.result()), host, web_port, public_url)
-        browsers = f", browsers on {public_url or f'http://{host}:{web_port}'}"
+        ws_url = webserver.local_url(host, ready.result(), plan.public_url, tls is not None)
+        web = webserver.start(webserver.WebConfig(ws_url, host, plan.port, plan.public_url, plan.instructor_hash,
+                                                  plan.lockout_s, plan.consoles, plan.certfile, plan.keyfile))
+        http = "https" if tls else "http"
+        browsers = f", browsers on {plan.public_url or f'{http}://{host}:{plan.port}'}"
     of = "at one simulation of" if server.classroom.shared else "of"
-    print(f"liansuo serve: {seats} seats {of} {server.classroom.station_ref} on ws://{host}:{ready.result()}"
+    print(f"liansuo serve: {seats} seats {of} {server.classroom.station_ref} on {scheme}://{host}:{ready.result()}"
           f"{browsers} (ctrl+c stops)", flush=True)
     try:
         await task

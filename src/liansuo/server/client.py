@@ -13,15 +13,20 @@ from typing import Any
 
 from websockets.sync.client import ClientConnection, connect
 
+from liansuo.server.tls import client_context
+
 
 class ClassroomError(RuntimeError):
     """The server refused the client (its error message) or closed the connection."""
 
 
 class ClassroomClient:
-    def __init__(self, url: str, hello: dict[str, Any], *, timeout: float = 10.0) -> None:
+    def __init__(self, url: str, hello: dict[str, Any], *, timeout: float = 10.0, cafile: str | None = None) -> None:
+        """``cafile``: for a wss:// server, the CA (or the server's own certificate) to verify it with, instead of
+        the system's CAs."""
         self.timeout = timeout
-        self.ws: ClientConnection = connect(url, open_timeout=timeout).__enter__()  # closed by close()
+        self.ws: ClientConnection = connect(url, open_timeout=timeout,
+                                            ssl=client_context(url, cafile)).__enter__()  # closed by close()
         self.ws.send(json.dumps({"type": "hello", **hello}))
         self.welcome = self._next()
         if self.welcome.get("type") != "welcome":
@@ -32,12 +37,13 @@ class ClassroomClient:
         self._id = 0
 
     @classmethod
-    def trainee(cls, url: str, seat: int, name: str = "", token: str | None = None) -> ClassroomClient:
-        return cls(url, {"role": "trainee", "seat": seat, "name": name, "token": token})
+    def trainee(cls, url: str, seat: int, name: str = "", token: str | None = None, *,
+                cafile: str | None = None) -> ClassroomClient:
+        return cls(url, {"role": "trainee", "seat": seat, "name": name, "token": token}, cafile=cafile)
 
     @classmethod
-    def instructor(cls, url: str, password: str) -> ClassroomClient:
-        return cls(url, {"role": "instructor", "password": password})
+    def instructor(cls, url: str, password: str, *, cafile: str | None = None) -> ClassroomClient:
+        return cls(url, {"role": "instructor", "password": password}, cafile=cafile)
 
     @property
     def token(self) -> str:

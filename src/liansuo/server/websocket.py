@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import asyncio
 import json
+import ssl
 import sys
 import time
 import traceback
@@ -79,11 +80,12 @@ class ClassroomServer:
         self._tasks: set[asyncio.Task[None]] = set()
 
     # ---- the loop -------------------------------------------------------------------------------------------------
-    async def serve(self, host: str, port: int, ready: asyncio.Future[int] | None = None) -> None:
-        """Serve until cancelled; ``ready`` gets the port listened on (useful with port 0)."""
+    async def serve(self, host: str, port: int, ready: asyncio.Future[int] | None = None,
+                    tls: ssl.SSLContext | None = None) -> None:
+        """Serve until cancelled; ``ready`` gets the port listened on (useful with port 0); with ``tls``, wss://."""
         with ThreadPoolExecutor(1, thread_name_prefix="liansuo-password") as hasher:
             self._hasher = hasher
-            async with serve(self.handle, host, port, max_size=MAX_MESSAGE) as server:
+            async with serve(self.handle, host, port, max_size=MAX_MESSAGE, ssl=tls) as server:
                 bound = next(iter(server.sockets)).getsockname()[1]
                 if ready is not None:
                     ready.set_result(bound)

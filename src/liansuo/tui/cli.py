@@ -57,8 +57,12 @@ def register(add: Add, connect: Handler | None = None) -> None:
                           "password); else LIANSUO_CHANGEOVER_PASSWORD")
     room = sp.add_argument_group("classroom", "the console as a client of 'liansuo serve' ('liansuo docs classroom')")
     room.add_argument("--connect", metavar="URL",
-                      help="connect to the classroom server at URL (ws://HOST:PORT): the station and the clock are "
-                           "the server's; without --seat or --instructor a login screen asks")
+                      help="connect to the classroom server at URL (ws://HOST:PORT, or wss:// to a server with TLS): "
+                           "the station and the clock are the server's; without --seat or --instructor a login "
+                           "screen asks")
+    room.add_argument("--cafile", metavar="FILE",
+                      help="with --connect wss://: trust the server's certificate if this CA (PEM: a school's own CA, "
+                           "or the server's self-signed certificate) signed it, instead of the system's CAs")
     room.add_argument("--seat", type=int, metavar="N", help="with --connect: take trainee seat N")
     room.add_argument("--name", metavar="NAME", help="with --seat: the trainee's name, for the report")
     room.add_argument("--instructor", action="store_true",
@@ -163,8 +167,8 @@ def _field(args: argparse.Namespace, station: Station) -> tuple[FieldLink, str] 
 
 def _classroom_only(args: argparse.Namespace) -> str | None:
     """The first option given that only a classroom's client takes."""
-    return next((o for o, v in (("--seat", args.seat), ("--name", args.name), ("--instructor", args.instructor))
-                 if v not in (None, False)), None)
+    given = (("--seat", args.seat), ("--name", args.name), ("--instructor", args.instructor), ("--cafile", args.cafile))
+    return next((o for o, v in given if v not in (None, False)), None)
 
 
 def _connect(args: argparse.Namespace) -> int:
