@@ -29,7 +29,7 @@ CLASSROOM_KEYS = {
     "station", "round_trips", "gap_ms", "memory_commands", "memory_line_chars", "memory_growth_kb", "memory_log_lines",
     *(f"{case}_rtt_ms_{s}" for case in ("quiet", "flood", "login") for s in ("median", "p95", "max")),
     "flood_sent", "flood_s", "flood_offered_per_s", "flood_read", "flood_read_per_s", "login_round_trips", "logins",
-    "logins_checked", "logins_locked_out", "logins_busy", "logins_failed", "logins_s",
+    "logins_checked", "logins_locked_out", "logins_busy", "logins_turned_away", "logins_failed", "logins_s",
 }
 NO_CLASSROOM = replace(Sizes.tiny(), classroom_round_trips=0)  # the command line's tests: no server to start
 POSITIVE = ("turnouts", "sections", "routes", "load_s", "table_build_s", "cycle_us_idle", "cycle_us_busy",
@@ -89,7 +89,7 @@ def test_the_classroom_under_attack_is_measured_and_every_attack_accounted_for(r
     assert room["flood_sent"] > room["flood_read"] > 0  # the server read the flood at its own pace, not the client's
     assert room["flood_offered_per_s"] > 0 and room["flood_s"] > 0
     assert room["logins"] == sizes.classroom_logins == sum(
-        room[f"logins_{k}"] for k in ("checked", "locked_out", "busy", "failed"))
+        room[f"logins_{k}"] for k in ("checked", "locked_out", "busy", "turned_away", "failed"))
     assert room["logins_failed"] == 0 and 1 <= room["logins_checked"] <= 5  # the lockout let at most 5 be checked
     assert room["login_round_trips"] >= 1
     assert room["memory_log_lines"] == 1000  # the seat's log at its bound

@@ -52,34 +52,42 @@ def flood(url: str, seat: int) -> None:
 async def _login(url: str, i: int) -> str:
     """One wrong instructor login: the server's reply, or why there was none."""
     from websockets.asyncio.client import connect
-    from websockets.exceptions import WebSocketException
+    from websockets.exceptions import InvalidStatus, WebSocketException
 
     try:
         async with connect(url, open_timeout=60) as ws:
             await ws.send(json.dumps({"type": "hello", "role": "instructor", "password": f"guess {i}"}))
             reply = json.loads(await asyncio.wait_for(ws.recv(), 60))
             return str(reply.get("message", reply.get("type")))
+    except InvalidStatus as exc:  # refused before the websocket opened (too many from this address)
+        return f"refused with HTTP {exc.response.status_code}"
     except (OSError, TimeoutError, WebSocketException) as exc:
         return f"no reply: {type(exc).__name__}"
+
+
+KINDS = ("checked", "locked_out", "busy", "turned_away", "failed")
 
 
 def kind(reply: str) -> str:
     """What happened to a wrong login: its password ``checked``, or refused unchecked by the address's lockout
     (``locked_out``, with the checks under way from that address) or the server's limit on checks at once
-    (``busy``); ``failed``: no reply at all."""
+    (``busy``), or refused before its websocket opened, its address having too many connections open
+    (``turned_away``); ``failed``: no reply at all."""
     if reply.startswith("wrong instructor password"):
         return "checked"
     if reply.startswith("too many"):
         return "locked_out"
     if "busy checking" in reply:
         return "busy"
+    if reply == "refused with HTTP 429":
+        return "turned_away"
     return "failed"
 
 
 async def _logins(url: str, n: int) -> dict[str, Any]:
     t0 = time.perf_counter()
     replies = await asyncio.gather(*(_login(url, i) for i in range(n)))
-    counts = {k: 0 for k in ("checked", "locked_out", "busy", "failed")}
+    counts = {k: 0 for k in KINDS}
     for reply in replies:
         counts[kind(reply)] += 1
     return {**counts, "seconds": time.perf_counter() - t0}

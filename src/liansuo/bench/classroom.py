@@ -21,6 +21,8 @@ from importlib.util import find_spec
 from pathlib import Path
 from typing import IO, TYPE_CHECKING, Any
 
+from liansuo.bench.attackers import KINDS
+
 if TYPE_CHECKING:
     from liansuo.server.client import ClassroomClient
 
@@ -176,7 +178,7 @@ def _logins(url: str, honest: ClassroomClient, n: int, logins: int) -> dict[str,
     finally:
         _end(wave)
     return {**_stats("login", during), "login_round_trips": len(during), "logins": logins,
-            **{f"logins_{k}": counts[k] for k in ("checked", "locked_out", "busy", "failed")},
+            **{f"logins_{k}": counts[k] for k in KINDS},
             "logins_s": round(counts["seconds"], 2)}
 
 
@@ -225,6 +227,7 @@ def text(c: dict[str, Any]) -> list[str]:
             f"{c['flood_offered_per_s']:,}/s; the server read {c['flood_read']:,}, {c['flood_read_per_s']:.0f}/s)",
             f"{'  wrong logins at once':26}{rtt('login')}  ({c['login_round_trips']} round trips during "
             f"{c['logins']} wrong logins in {c['logins_s']:.1f} s: {c['logins_checked']} checked, "
-            f"{c['logins_locked_out']} locked out, {c['logins_busy']} busy, {c['logins_failed']} unanswered)",
+            f"{c['logins_locked_out']} locked out, {c['logins_busy']} busy, {c['logins_turned_away']} turned away at "
+            f"connect, {c['logins_failed']} unanswered)",
             f"{'  memory':26}{c['memory_growth_kb']:+.0f} kB over the last 90 % of {c['memory_commands']:,} commands "
             f"({c['memory_log_lines']} log lines kept)"]

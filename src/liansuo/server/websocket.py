@@ -18,14 +18,18 @@ import ssl
 import sys
 import time
 import traceback
+import weakref
 from collections.abc import Coroutine
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
+from http import HTTPStatus
 from typing import Any
 
 from pydantic import ValidationError
 from websockets.asyncio.server import ServerConnection, serve
 from websockets.exceptions import ConnectionClosed
+from websockets.http11 import Request, Response
+from websockets.protocol import State
 
 from liansuo.classroom.passwords import matches
 from liansuo.classroom.roles import INSTRUCTOR, TRAINEE
@@ -51,6 +55,7 @@ TICK_S = 0.05  # the clocks' pace on the wall clock
 PUSH_S = 0.25  # a snapshot to each client this often
 MAX_MESSAGE = 64 * 1024
 HELLO_TIMEOUT_S = 10.0
+MAX_ADDRESSES = 10_000  # addresses remembered with connections open
 MAX_CHECKS = 16  # instructor password checks waiting or running at once, from every address together
 
 
@@ -78,6 +83,10 @@ class ClassroomServer:
         self._checks = 0  # password checks waiting or running
         self._hasher: ThreadPoolExecutor | None = None  # the password checks' one thread, while serving
         self._tasks: set[asyncio.Task[None]] = set()
+        # connections from one address at once: every seat's console and its redial, the browsers' logins, the
+        # instructor; past it a connection is refused before its websocket opens, so a wave of them costs little
+        self.per_address = 2 * len(classroom.seats) + 16
+        self._by_address: dict[str, weakref.WeakSet[ServerConnection]] = {}
 
     # ---- the loop -------------------------------------------------------------------------------------------------
     async def serve(self, host: str, port: int, ready: asyncio.Future[int] | None = None,
@@ -85,11 +94,25 @@ class ClassroomServer:
         """Serve until cancelled; ``ready`` gets the port listened on (useful with port 0); with ``tls``, wss://."""
         with ThreadPoolExecutor(1, thread_name_prefix="liansuo-password") as hasher:
             self._hasher = hasher
-            async with serve(self.handle, host, port, max_size=MAX_MESSAGE, ssl=tls) as server:
+            async with serve(self.handle, host, port, max_size=MAX_MESSAGE, ssl=tls,
+                             process_request=self.admit_connection) as server:
                 bound = next(iter(server.sockets)).getsockname()[1]
                 if ready is not None:
                     ready.set_result(bound)
                 await self.run_clocks()
+
+    def admit_connection(self, ws: ServerConnection, request: Request) -> Response | None:
+        """Before the websocket opens: refused (429) when its address has :attr:`per_address` connections open."""
+        address = _address(ws)
+        live = self._by_address.setdefault(address, weakref.WeakSet())
+        if sum(c.state is not State.CLOSED for c in live) >= self.per_address:
+            return ws.respond(HTTPStatus.TOO_MANY_REQUESTS, f"{address} has {self.per_address} connections open to "
+                              "this classroom: close some, or wait\n")
+        live.add(ws)
+        if len(self._by_address) > MAX_ADDRESSES:  # forget the addresses with nothing open
+            self._by_address = {a: c for a, c in self._by_address.items() if any(
+                x.state is not State.CLOSED for x in c)}
+        return None
 
     async def run_clocks(self) -> None:
         last = time.monotonic()
