@@ -449,3 +449,42 @@ async def test_an_exercise_with_several_goals_keeps_each_goal_once_met_and_shows
         assert app.sim.aspect("X3") == "H"  # the train has gone: goal 1's green is long over
         assert app.goal.met == [True, True] and app.goal_reached_at is not None
         assert "goal reached" in message(app)
+
+
+def branch_colours(app: ConsoleApp, track: str) -> set[str]:
+    """The colours the diagram draws a track's band and diagonal cells in now (the turnout's leg cell left out)."""
+    d = app.diagram
+    d.update_view()
+    assert d.layout_ is not None
+    frame = d.frame()
+    out = set()
+    for x, y in d.layout_.track_cells[track][2]:
+        g = d.layout_.at(x, y)
+        if g is not None and g.role in ("band", "diag") and g.track == track and g.leg is None:
+            out.add(str(glyph(frame, g, set())[1].color.name))  # type: ignore[union-attr]
+    return out
+
+
+@run
+async def test_a_locked_turnout_section_lights_only_the_branch_its_route_runs_over() -> None:
+    """Issue 46, item 9: a 6502 panel and a CBI display light a locked turnout section white along the route's
+    branch only; the branch the turnout does not lie on stays dark. Occupied, the whole section is red, as its track
+    relay shows it."""
+    app = ConsoleApp("jiaopei", paused=True)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        white, free, red = BAND_COLOUR["locked"], BAND_COLOUR["free"], BAND_COLOUR["occupied"]
+        assert app.sim.command("route X XI").ok
+        cycles(app, 40)
+        assert app.sim.section_state("1DG") == "locked"
+        assert branch_colours(app, "t-1a") == branch_colours(app, "t-1b") == {white}
+        assert branch_colours(app, "t-1c") == {free}  # 1 lies normal: its reverse branch is not the route's
+        assert app.sim.command("cancel X").ok
+        cycles(app, 40)
+        assert app.sim.command("route X X3").ok
+        cycles(app, 80)
+        assert app.sim.section_state("1DG") == "locked"
+        assert branch_colours(app, "t-1c") == {white} and branch_colours(app, "t-1b") == {free}
+        assert app.sim.command("occupy 1DG").ok
+        cycles(app, 4)
+        assert branch_colours(app, "t-1b") == branch_colours(app, "t-1c") == {red}

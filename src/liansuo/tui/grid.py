@@ -37,6 +37,7 @@ class Glyph:
     leg: tuple[str, str] | None = None  # (turnout, leg) for the cell next to a turnout on that leg
     slot: int = 0  # lamp slot of a signal; door index of a platform; block lamp (0 departure, 1 arrival)
     also: str = ""  # a second section drawn over the same cell (a crossing)
+    track: str = ""  # the track a band or diagonal cell draws (a turnout section's branch lights on its own)
 
 
 @dataclass

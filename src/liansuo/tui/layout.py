@@ -359,7 +359,7 @@ def _paint(b: _Builder, col: list[int], lay: Layout) -> None:
             if k == len(path) - 1 and bb.leg in ("normal", "reverse"):
                 leg = (bb.node, bb.leg)
             role = "band" if ch == BAND else "diag"
-            _put(lay, x, y, Glyph(ch, role, Ref("section", sec), sec, leg))
+            _put(lay, x, y, Glyph(ch, role, Ref("section", sec), sec, leg, track=tid))
             lay.section_cells.setdefault(sec, []).append((x, y))
     _paint_nodes(b, lay, cx, cy)
     for fp in st.model.fouling_points:

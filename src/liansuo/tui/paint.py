@@ -1,6 +1,7 @@
 """Colours of the station diagram from the simulation's state, as a Chinese CBI display shows them.
 
-Sections: a plain band when free, white when locked in a route, red when occupied (红光带). Turnouts: the number
+Sections: a plain band when free, white when locked in a route (in a turnout section only the branch the route runs
+over), red when occupied (红光带: the whole section, as its track relay shows it). Turnouts: the number
 green at normal, yellow at reverse, flashing red without indication; the leg not set is left open at the turnout;
 a red mark for single lock (单锁), a red cross for single block (单封), a white mark for guide total lock. Signals:
 the lamps actually lit in the field (a flashing USU lamp blinks with the flasher), a dark lamp of the commanded
@@ -68,6 +69,10 @@ class Frame:
     doors: dict[str, str]
     flash: bool
     blocks: dict[str, str] = field(default_factory=dict)  # block line -> its state (view.block_line)
+    # section -> the tracks of it that the routes held run over: a locked turnout section lights those only (the
+    # branch its turnouts lie on for the route, as a 6502 panel and a CBI display do); a section with none of its
+    # tracks on a route's path (locked by an overlap, say) lights whole
+    lit: dict[str, set[str]] = field(default_factory=dict)
     overlay: dict[tuple[int, int], tuple[str, Style]] = field(default_factory=dict)
 
 
@@ -96,7 +101,20 @@ def read_frame(sim: ConsoleSim, lay: Layout) -> Frame:
     blocks = {lk.id: state for lk in st.model.links if (state := view.block_line(lk.id)) is not None}
     lost = any(pos is None for pos, _ in turnouts.values())
     return Frame(sections, turnouts, lamps, countdown, alarmed, doors, int(sim.t * 2) % 2 == 0 if lost else True,
-                 blocks=blocks)
+                 blocks=blocks, lit=routes_lit(sim))
+
+
+def routes_lit(sim: ConsoleSim) -> dict[str, set[str]]:
+    """Per section, the tracks the routes held run over (their paths, from the interlocking table)."""
+    lit: dict[str, set[str]] = {}
+    tracks = sim.station.tracks
+    for r in sim.view.routes():
+        route = sim.table.routes.get(r.id)
+        if route is None:
+            continue
+        for t in route.path.tracks:
+            lit.setdefault(tracks[t].section, set()).add(t)
+    return lit
 
 
 def add_overlays(frame: Frame, sim: ConsoleSim, lay: Layout) -> None:
@@ -157,6 +175,8 @@ def _runs(cells: list[tuple[int, int]]) -> list[list[tuple[int, int]]]:
 
 def band_style(frame: Frame, g: Glyph) -> Style:
     state = frame.sections.get(g.section, "free")
+    if state == "locked" and g.track and g.track not in frame.lit.get(g.section, {g.track}):
+        state = "free"  # the branch of a locked turnout section the route does not run over
     if g.also:
         other = frame.sections.get(g.also, "free")
         if SEVERITY[other] > SEVERITY[state]:
