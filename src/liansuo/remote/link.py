@@ -20,7 +20,8 @@ import contextlib
 import itertools
 import json
 import threading
-from typing import Any
+from collections.abc import AsyncGenerator
+from typing import Any, cast
 
 from websockets.asyncio.client import ClientConnection
 from websockets.asyncio.client import connect as connecting
@@ -179,16 +180,16 @@ class ServerLink:
 
     # ---- the thread -----------------------------------------------------------------------------------------------
     def _run(self, first: concurrent.futures.Future[dict[str, Any]]) -> None:
-        asyncio.set_event_loop(self._loop)
-        self._main = self._loop.create_task(self._connections(first))
-        try:
-            self._loop.run_until_complete(self._main)
-        except asyncio.CancelledError:
-            pass
-        finally:
-            self.connected = False
-            self._loop.run_until_complete(self._loop.shutdown_asyncgens())  # closes the reconnecting client's last
-            self._loop.close()
+        # the Runner, as asyncio.run, cancels what is left (keepalives) and closes the loop at the end
+        with asyncio.Runner(loop_factory=lambda: self._loop) as runner:
+            try:
+                runner.run(self._connections(first))
+            except asyncio.CancelledError:
+                pass
+            finally:
+                self.connected = False
+                if not first.done():  # never left waiting, whatever ended the thread
+                    first.set_exception(LinkError(f"the link to the classroom server at {self.url} ended at once"))
 
     def _cancel(self) -> None:
         if self._main is not None:
@@ -196,6 +197,7 @@ class ServerLink:
 
     async def _connections(self, first: concurrent.futures.Future[dict[str, Any]]) -> None:
         """The first connection, then every one websockets' reconnecting client makes after a drop."""
+        self._main = asyncio.current_task()
         try:
             dial = connecting(self.url, open_timeout=OPEN_TIMEOUT_S, close_timeout=1,
                               create_connection=greeted(self._hello), process_exception=transient)
@@ -212,12 +214,13 @@ class ServerLink:
                 return
         finally:
             await ws.close()
-        try:
-            async for ws in dial:  # after a drop: dial again at once, then with backoff while that fails
-                await self._open(ws)
-                self.generation += 1
-                if not await self._session(ws):
-                    return
+        try:  # after a drop: dial again at once, then with backoff while that fails
+            async with contextlib.aclosing(cast(AsyncGenerator[ClientConnection, None], dial.__aiter__())) as again:
+                async for ws in again:  # closed with the generator, when the session ended or the link closes
+                    await self._open(ws)
+                    self.generation += 1
+                    if not await self._session(ws):
+                        return
         except Exception as exc:  # a refusal, or a failure that dialling again would not mend
             self.problem, self.ended = str(why_not(self.url, exc)), True
 
