@@ -299,20 +299,30 @@ async def test_a_seat_freed_by_the_instructor_ends_the_trainees_link_and_says_wh
         assert "ended" in message(app) and "nothing was sent" in message(app), message(app)
 
 
-def test_a_refused_hello_after_a_drop_ends_the_link_and_says_why(server: Server) -> None:
+def wait_for(condition: Callable[[], bool], seconds: float, why: Callable[[], object]) -> None:
+    deadline = time.monotonic() + seconds
+    while not condition():
+        assert time.monotonic() < deadline, why()
+        time.sleep(0.1)
+
+
+def test_the_instructors_link_comes_back_on_its_seat_and_a_refused_hello_ends_it(server: Server) -> None:
     link = ServerLink(server.url, {"role": "instructor", "password": PASSWORD})
     try:
         assert link.watch(2)["type"] == "ok"
         server.stop()
+        server.start(server.port)
+        wait_for(lambda: link.connected and link.generation == 1, 12, lambda: link.problem)
+        link.take()
+        wait_for(lambda: (link.take()[0] or {}).get("seat") == 2, 5, link.take)  # seat 2's, watched again
+        assert link.command("route X XI")["ok"] and link.seat == 2
+        server.stop()
         server.server.instructor_hash = hash_password("another horse")  # restarted with another password
         server.start(server.port)
-        deadline = time.monotonic() + 12
-        while not link.ended:
-            assert time.monotonic() < deadline, (link.connected, link.problem)
-            time.sleep(0.1)
+        wait_for(lambda: link.ended, 12, lambda: (link.connected, link.problem))
         assert "the classroom server refused: wrong instructor password" in link.problem, link.problem
         time.sleep(1.5)
-        assert not link.connected and link.generation == 0
+        assert not link.connected and link.generation == 1
         assert server.server.guard._seen["127.0.0.1"].failures == 1  # tried once, not again and again
     finally:
         link.close()

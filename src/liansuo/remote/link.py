@@ -229,9 +229,10 @@ class ServerLink:
         welcome: dict[str, Any] = getattr(ws, "welcome", {})
         if welcome.get("token"):
             self._hello["token"] = welcome["token"]  # a restarted server gives the seat a new one
-        if self.role == "instructor" and self.seat != int(welcome.get("seat") or 1):  # watch the same seat again;
-            await ws.send(json.dumps({"type": "watch", "seat": self.seat, "id": next(self._ids)}))  # the reply,
-            # with an id nobody waits for, goes to nobody
+        if self.role == "instructor" and self.seat != int(welcome.get("seat") or 1):  # watch the same seat again
+            with contextlib.suppress(ConnectionClosed):  # closed already: the session ends at once, and is dialled
+                await ws.send(json.dumps({"type": "watch", "seat": self.seat, "id": next(self._ids)}))  # its reply,
+                # with an id nobody waits for, goes to nobody
         with self._lock:
             self._snapshot = None
         self._ws, self.connected, self.problem = ws, True, ""
