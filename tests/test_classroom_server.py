@@ -11,7 +11,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
-from websockets.sync.client import connect
+from websockets.sync.client import ClientConnection, connect
 
 from liansuo.classroom.passwords import hash_password, instructor_hash, matches
 from liansuo.classroom.snapshot import EventCursor
@@ -105,6 +105,38 @@ def test_bad_messages_get_an_error_reply_and_the_server_carries_on(url: str) -> 
             reply = _reply(c)
             assert reply["type"] == "error", (raw, reply)
         assert c.command("route X XI")["type"] == "answer"
+
+
+def test_every_reply_carries_the_id_of_its_message_and_none_without_one(url: str) -> None:
+    def reply(ws: ClientConnection) -> dict[str, object]:
+        while True:
+            msg = json.loads(ws.recv(timeout=5))
+            if msg["type"] not in ("snapshot", "seats"):
+                return dict(msg)
+
+    with connect(url) as ws:
+        ws.send(json.dumps({"type": "lobby", "id": 7}))
+        assert reply(ws)["id"] == 7
+    with connect(url) as ws:
+        ws.send(json.dumps({"type": "hello", "id": 8, "role": "trainee", "seat": 1, "name": "Li"}))
+        assert (welcome := reply(ws))["type"] == "welcome" and welcome["id"] == 8, welcome
+        cases: list[tuple[dict[str, object], str]] = [
+            ({"type": "command", "id": 2**53, "line": "route X XI"}, "answer"),
+            ({"type": "watch", "id": 0, "seat": 1}, "error"),  # the instructor's
+            ({"type": "command", "id": 11, "line": 5}, "error"),  # unreadable, its id readable
+            ({"type": "command", "line": "cancel X"}, "answer")]
+        for raw, kind in cases:
+            ws.send(json.dumps(raw))
+            got = reply(ws)
+            assert got["type"] == kind and got.get("id") == raw.get("id"), (raw, got)
+            assert "id" in got or "id" not in raw, got
+        for bad in (True, -1, 2**53 + 1, "12"):  # not an id: refused, and not echoed
+            ws.send(json.dumps({"type": "command", "id": bad, "line": "cancel X"}))
+            got = reply(ws)
+            assert got["type"] == "error" and "id" not in got and "id" in str(got["message"]), (bad, got)
+    with connect(url) as ws:
+        ws.send(json.dumps({"type": "hello", "id": 9, "role": "trainee", "seat": 99}))
+        assert (refused := reply(ws))["type"] == "error" and refused["id"] == 9, refused
 
 
 def _reply(c: ClassroomClient) -> dict[str, object]:

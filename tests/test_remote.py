@@ -6,7 +6,10 @@ a user drives them (Textual's Pilot)."""
 from __future__ import annotations
 
 import asyncio
+import itertools
+import socket
 import threading
+import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
@@ -18,7 +21,7 @@ from liansuo.classroom.passwords import hash_password
 from liansuo.remote.app import RemoteConsoleApp
 from liansuo.remote.dashboard import DashboardScreen
 from liansuo.remote.link import ServerLink
-from liansuo.remote.sim import LOST
+from liansuo.remote.sim import ENDED, LOST
 from liansuo.server.classroom import Classroom
 from liansuo.server.client import ClassroomClient
 from liansuo.server.websocket import ClassroomServer
@@ -29,9 +32,9 @@ PASSWORD = "correct horse"
 class Server:
     """A classroom server in a thread of its own, stopped and started again on the same port at will."""
 
-    def __init__(self, seats: int = 2, reports: Path | None = None) -> None:
+    def __init__(self, seats: int = 2, reports: Path | None = None, **limits: float) -> None:
         self.classroom = Classroom("jiaopei", seats, reports=reports)
-        self.server = ClassroomServer(self.classroom, hash_password(PASSWORD))
+        self.server = ClassroomServer(self.classroom, hash_password(PASSWORD), **limits)  # type: ignore[arg-type]
         self.loop = asyncio.new_event_loop()
         self.thread = threading.Thread(target=self.loop.run_forever, daemon=True)
         self.thread.start()
@@ -201,6 +204,128 @@ async def test_connection_lost_shows_the_fail_safe_picture_and_comes_back(server
         assert LOST not in str(app.status_bar.content)
         await type_line(pilot, "route X XI")
         assert "✓" in message(app), message(app)
+
+
+def test_a_late_reply_never_answers_the_next_request(tmp_path: Path) -> None:
+    """The server reads this client's messages one a second: the second request's reply comes after the request
+    gave up, while the third request waits. The third gets its own reply, never the late one."""
+    slow = Server(reports=tmp_path, rate=1.0, burst=1.0)
+    link = ServerLink(slow.url, {"role": "trainee", "seat": 1, "name": "Li"})
+    try:
+        first = link.command("cancel X")  # takes the one message the server reads at once
+        assert first["type"] == "answer" and "no route is set" in first["message"], first
+        link.timeout = 0.3
+        late = link.command("route X XI")  # read by the server a second later
+        assert late == {"type": "error", "message": "no answer from the classroom server in 0.3 s"}, late
+        link.timeout = 5.0
+        own = link.request({"type": "watch", "seat": 2})  # its reply comes after the late one ('route X-XI selected')
+        assert own["type"] == "error" and "'watch' is the instructor's" in own["message"], own
+        after = link.command("cancel X")
+        assert after["type"] == "answer" and after["message"] == "route X-XI cancelled", after  # the late one ran
+    finally:
+        link.close()
+        slow.close()
+
+
+class Listener:
+    """A port that accepts each connection and closes it at once, noting when: a server that is down but whose
+    port still answers, and counts the dials."""
+
+    def __init__(self, port: int) -> None:
+        self.sock = socket.socket()
+        self.sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        self.sock.bind(("127.0.0.1", port))
+        self.sock.listen()
+        self.sock.settimeout(0.1)
+        self.dials: list[float] = []
+        self.open = True
+        self.thread = threading.Thread(target=self.serve, daemon=True)
+        self.thread.start()
+
+    def serve(self) -> None:
+        while self.open:
+            try:
+                conn, _ = self.sock.accept()
+            except TimeoutError:
+                continue
+            self.dials.append(time.monotonic())
+            conn.close()
+
+    def close(self) -> None:
+        self.open = False
+        self.thread.join(5)
+        self.sock.close()
+
+
+@run
+async def test_the_link_dials_again_with_backoff_and_the_console_comes_back(server: Server) -> None:
+    app = RemoteConsoleApp(ServerLink(server.url, {"role": "trainee", "seat": 1, "name": "Li"}))
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await until(pilot, lambda: app.remote.live and band(app, "IG") == BAND_COLOUR["free"])
+        server.stop()
+        listener = Listener(server.port)
+        try:
+            await pilot.pause(8.5)
+        finally:
+            listener.close()
+        gaps = [b - a for a, b in itertools.pairwise(listener.dials)]
+        # websockets' backoff: at once, then within 5 s (at random), then 3.1 s, 5 s, 8.1 s ... later; every second
+        # would be 8 dials or more
+        assert 2 <= len(listener.dials) <= 4, listener.dials
+        assert gaps[-1] >= 3.0, gaps
+        assert not app.link.connected and not app.link.ended and LOST in str(app.status_bar.content)
+        server.start(server.port)
+        await until(pilot, lambda: app.link.connected and band(app, "IG") == BAND_COLOUR["free"], 14)
+        assert app.link.generation == 1 and LOST not in str(app.status_bar.content)
+        await type_line(pilot, "route X XI")
+        assert "✓" in message(app), message(app)
+
+
+@run
+async def test_a_seat_freed_by_the_instructor_ends_the_trainees_link_and_says_why(server: Server) -> None:
+    app = RemoteConsoleApp(ServerLink(server.url, {"role": "trainee", "seat": 1, "name": "Li"}))
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await until(pilot, lambda: app.remote.live)
+        with ClassroomClient.instructor(server.url, PASSWORD) as teacher:
+            assert teacher.request({"type": "free", "seats": [1]})["type"] == "ok"
+        await until(pilot, lambda: app.link.ended)
+        await pilot.pause(1.5)  # the console dials no more: the seat stays free for another trainee
+        assert "the instructor freed seat 1" in message(app) and ENDED in message(app), message(app)
+        assert ENDED in str(app.status_bar.content) and band(app, "IG") == BAND_COLOUR["occupied"]
+        assert not server.classroom.seat(1).token and not app.link.connected
+        await type_line(pilot, "route X XI")
+        assert "ended" in message(app) and "nothing was sent" in message(app), message(app)
+
+
+def wait_for(condition: Callable[[], bool], seconds: float, why: Callable[[], object]) -> None:
+    deadline = time.monotonic() + seconds
+    while not condition():
+        assert time.monotonic() < deadline, why()
+        time.sleep(0.1)
+
+
+def test_the_instructors_link_comes_back_on_its_seat_and_a_refused_hello_ends_it(server: Server) -> None:
+    link = ServerLink(server.url, {"role": "instructor", "password": PASSWORD})
+    try:
+        assert link.watch(2)["type"] == "ok"
+        server.stop()
+        server.start(server.port)
+        wait_for(lambda: link.connected and link.generation == 1, 12, lambda: link.problem)
+        link.take()
+        wait_for(lambda: (link.take()[0] or {}).get("seat") == 2, 5, link.take)  # seat 2's, watched again
+        assert link.command("route X XI")["ok"] and link.seat == 2
+        server.stop()
+        server.server.instructor_hash = hash_password("another horse")  # restarted with another password
+        server.start(server.port)
+        wait_for(lambda: link.ended, 12, lambda: (link.connected, link.problem))
+        assert "the classroom server refused: wrong instructor password" in link.problem, link.problem
+        time.sleep(1.5)
+        assert not link.connected and link.generation == 1
+        assert server.server.guard._seen["127.0.0.1"].failures == 1  # tried once, not again and again
+    finally:
+        link.close()
 
 
 @pytest.mark.parametrize(("argv", "why"), [

@@ -22,7 +22,7 @@ from liansuo.kit.printable import printable
 from liansuo.remote.dashboard import DashboardScreen, ExerciseChoice, ExercisePicker
 from liansuo.remote.link import ServerLink, Unlinked
 from liansuo.remote.login import LoginScreen
-from liansuo.remote.sim import LOST, NOT_IN, RemoteSimulation
+from liansuo.remote.sim import ENDED, LOST, NOT_IN, RemoteSimulation
 from liansuo.tui.app import SPEEDS, ConsoleApp
 from liansuo.tui.instructor import InstructorPanel
 
@@ -44,6 +44,7 @@ class RemoteConsoleApp(ConsoleApp):
         self.warm_up = False
         self._generation = link.generation
         self._was_live = True
+        self._ended = False
         self._lesson: tuple[str, str] | None = None  # the exercise last shown (title, briefing)
         self._lesson_ended = False
 
@@ -71,7 +72,7 @@ class RemoteConsoleApp(ConsoleApp):
         self.link = link
         self.remote.attach(link)
         self.instructor = link.role == INSTRUCTOR
-        self._generation, self._was_live = link.generation, True
+        self._generation, self._was_live, self._ended = link.generation, True, False
         self.remote.step()
         self.refresh_views()
         self.greet()
@@ -102,6 +103,10 @@ class RemoteConsoleApp(ConsoleApp):
                          else f"connection to the classroom server back: seat {self.seat}", live)
                 self.log_panel.add(f"{self.remote.t:9.2f} {'link':8} {'lost' if not live else 'back'}",
                                    "#ff6060" if not live else "#80ff80")
+            if self.link.ended and not self._ended:  # refused or sent away: the link dials no more
+                self._ended = True
+                self.say(printable(f"{ENDED}: {self.link.problem}"), False)
+                self.log_panel.add(printable(f"{self.remote.t:9.2f} {'link':8} ended: {self.link.problem}"), "#ff6060")
             self.follow_lesson()
             self.refresh_views()
         except Exception as exc:  # no traceback on the screen
@@ -197,7 +202,7 @@ class RemoteConsoleApp(ConsoleApp):
         if not self.logged_in:
             out.append(f"│ {NOT_IN} ", style="bold #ffffff on #c00000")
         elif not self.link.connected:
-            out.append(f"│ {LOST} ", style="bold #ffffff on #c00000")
+            out.append(f"│ {ENDED if self.link.ended else LOST} ", style="bold #ffffff on #c00000")
         return out
 
 

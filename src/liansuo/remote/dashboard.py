@@ -165,7 +165,8 @@ class DashboardScreen(Screen[None]):
     def refresh_seats(self) -> None:
         rows = [seat_row(s) for s in self.link.seats()]
         if not self.link.connected:
-            self.say("connection to the classroom server lost, reconnecting: the table is not live", False)
+            state = f"ended ({self.link.problem})" if self.link.ended else "lost, reconnecting"
+            self.say(f"connection to the classroom server {state}: the table is not live", False)
         if rows == self._shown:
             return
         table = self.query_one(DataTable)

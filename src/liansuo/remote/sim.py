@@ -27,6 +27,7 @@ from liansuo.stations.loader import load, load_text
 from liansuo.stations.station import Station
 
 LOST = "connection to the classroom server lost, reconnecting"
+ENDED = "connection to the classroom server ended"
 NOT_IN = "not logged in to the classroom yet"
 
 

@@ -60,17 +60,19 @@ class ClassroomClient:
         return msg
 
     def request(self, message: dict[str, Any]) -> dict[str, Any]:
-        """Send one message and return the server's reply to it (snapshots that arrive meanwhile are kept)."""
+        """Send one message, with a fresh ``id`` unless it has one, and return the server's reply with that id
+        (snapshots that arrive meanwhile are kept; a reply to an earlier message, sent raw, is skipped)."""
+        if "id" not in message:
+            self._id += 1
+            message = {**message, "id": self._id}
         self.ws.send(json.dumps(message))
         while True:
             msg = self._next()
-            if msg.get("type") not in ("snapshot", "seats"):
+            if msg.get("type") not in ("snapshot", "seats") and msg.get("id") == message["id"]:
                 return msg
 
     def command(self, line: str, seat: int | None = None) -> dict[str, Any]:
-        self._id += 1
-        return self.request({"type": "command", "id": self._id, "line": line,
-                             **({} if seat is None else {"seat": seat})})
+        return self.request({"type": "command", "line": line, **({} if seat is None else {"seat": seat})})
 
     def snapshot(self) -> dict[str, Any]:
         """The next snapshot the server sends."""

@@ -3,15 +3,20 @@ message and changes nothing (docs/classroom.md, "The protocol")."""
 
 from __future__ import annotations
 
+import json
 from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, TypeAdapter
 
+MAX_ID = 2**53  # the largest integer every JSON reader keeps exact
 Seats = Literal["all"] | list[Annotated[int, Field(ge=1, le=64)]]
 
 
 class _Message(BaseModel):
     model_config = ConfigDict(extra="forbid", strict=True)
+
+    id: int | None = Field(None, ge=0, le=MAX_ID, description="the client's name for the message: every reply to it "
+                                                             "carries the same id")
 
 
 class HelloMessage(_Message):
@@ -32,7 +37,6 @@ class LobbyMessage(_Message):
 
 class CommandMessage(_Message):
     type: Literal["command"]
-    id: int = Field(ge=0, le=2**53)
     line: str = Field(description="one line of the command language; past 500 characters it is refused")
     seat: int | None = Field(None, ge=1, le=64, description="the instructor's target seat; a trainee's is its own")
 
@@ -78,6 +82,16 @@ ClientMessage = (HelloMessage | LobbyMessage | CommandMessage | WatchMessage | C
                  | ExerciseMessage | StopMessage | FreeMessage)
 Message = Annotated[ClientMessage, Field(discriminator="type")]
 MESSAGE: TypeAdapter[ClientMessage] = TypeAdapter(Message)
+
+
+def message_id(raw: str | bytes) -> int | None:
+    """The ``id`` of a message that did not validate, when it has a valid one: its error reply carries it too."""
+    try:
+        data = json.loads(raw)
+    except ValueError:
+        return None
+    ident = data.get("id") if isinstance(data, dict) else None
+    return ident if type(ident) is int and 0 <= ident <= MAX_ID else None
 
 
 def problem(exc: Exception) -> str:

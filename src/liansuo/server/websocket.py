@@ -2,7 +2,8 @@
 
 A client's first message is a ``hello`` naming its role. A trainee gets one seat and its snapshots; the instructor
 (with the password) may watch any seat, send any command to any seat, and run the seats' clocks. The server answers
-every message; one it cannot read gets an ``error`` reply and changes nothing, and a client that disconnects may
+every message, with the message's ``id`` when it has one; one it cannot read gets an ``error`` reply and changes
+nothing, and a client that disconnects may
 take its seat back with the token it was given (only that token: the instructor frees a seat for another trainee).
 
 No client can freeze the class: each connection's messages are read at a bounded rate (:mod:`.throttle`), and the
@@ -47,6 +48,7 @@ from liansuo.server.messages import (
     LobbyMessage,
     StopMessage,
     WatchMessage,
+    message_id,
     problem,
 )
 from liansuo.server.throttle import BURST, RATE, TokenBucket
@@ -149,11 +151,13 @@ class ClassroomServer:
 
     async def greet(self, ws: ServerConnection) -> Client | None:
         """The first message: who the client is. None (after an error reply, connection closed) when refused."""
+        ident: int | None = None
         try:
             raw = await asyncio.wait_for(ws.recv(), HELLO_TIMEOUT_S)
+            ident = message_id(raw)
             hello = MESSAGE.validate_json(raw)
             if isinstance(hello, LobbyMessage):
-                await ws.send(json.dumps(self.lobby()))
+                await ws.send(json.dumps(_replying(ident, self.lobby())))
                 await ws.close(1000, "lobby")
                 return None
             if not isinstance(hello, HelloMessage):
@@ -161,13 +165,14 @@ class ClassroomServer:
             client = await self.admit(hello, _address(ws))
         except (TimeoutError, ValidationError, SeatError, ValueError) as exc:
             why = problem(exc) if isinstance(exc, ValidationError) else str(exc) or "no hello in time"
-            await ws.send(json.dumps({"type": "error", "message": why}))
+            await ws.send(json.dumps(_replying(ident, {"type": "error", "message": why})))
             await ws.close(1008, why[:120])
             return None
         seat = self.classroom.seat(client.seat)
-        await ws.send(json.dumps({"type": "welcome", "role": client.role, "seat": client.seat, "token": client.token,
-                                  "station": self.classroom.station_source(), "cycle_s": seat.sim.cycle_s,
-                                  "seats": len(self.classroom.seats)}))
+        await ws.send(json.dumps(_replying(ident, {
+            "type": "welcome", "role": client.role, "seat": client.seat, "token": client.token,
+            "station": self.classroom.station_source(), "cycle_s": seat.sim.cycle_s,
+            "seats": len(self.classroom.seats)})))
         return client
 
     def lobby(self) -> dict[str, Any]:
@@ -218,18 +223,21 @@ class ClassroomServer:
 
     # ---- one message --------------------------------------------------------------------------------------------
     def answer(self, client: Client, raw: str | bytes) -> dict[str, Any]:
-        """The reply to one message; never raises (an unexpected error is answered, and its traceback printed)."""
+        """The reply to one message, with its ``id`` when it has one; never raises (an unexpected error is answered,
+        and its traceback printed)."""
         try:
             msg = MESSAGE.validate_json(raw)
-            return self.dispatch(client, msg)
         except ValidationError as exc:
-            return {"type": "error", "message": f"cannot read the message: {problem(exc)}"}
+            return _replying(message_id(raw), {"type": "error", "message": f"cannot read the message: {problem(exc)}"})
+        try:
+            reply = self.dispatch(client, msg)
         except SeatError as exc:
-            return {"type": "error", "message": str(exc)}
+            reply = {"type": "error", "message": str(exc)}
         except Exception:  # the server carries on for every other client
             self.errors += 1
             traceback.print_exc(file=sys.stderr)
-            return {"type": "error", "message": "internal error on the server (reported in its log)"}
+            reply = {"type": "error", "message": "internal error on the server (reported in its log)"}
+        return _replying(msg.id, reply)
 
     def dispatch(self, client: Client, msg: ClientMessage) -> dict[str, Any]:
         instructor = client.role == INSTRUCTOR
@@ -242,7 +250,7 @@ class ClassroomServer:
                 raise SeatError("a trainee operates only their own seat")
             seat = msg.seat if instructor and msg.seat is not None else client.seat
             r = self.classroom.command(seat, client.role, msg.line)
-            return {"type": "answer", "id": msg.id, "seat": seat, "ok": r.ok, "message": r.message}
+            return {"type": "answer", "seat": seat, "ok": r.ok, "message": r.message}
         if not instructor:
             raise SeatError(f"'{msg.type}' is the instructor's: a trainee sends commands only")
         if isinstance(msg, WatchMessage):
@@ -277,6 +285,11 @@ class ClassroomServer:
         task = asyncio.create_task(work)
         self._tasks.add(task)
         task.add_done_callback(self._tasks.discard)
+
+
+def _replying(ident: int | None, reply: dict[str, Any]) -> dict[str, Any]:
+    """A reply carries the id of the message it answers; a message without one gets a reply without one."""
+    return reply if ident is None else {**reply, "id": ident}
 
 
 def _address(ws: ServerConnection) -> str:
