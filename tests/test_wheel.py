@@ -157,6 +157,10 @@ import subprocess
 import sys
 import time
 
+import http.client as http_client
+from urllib.parse import urlencode, urlsplit
+
+from websockets.exceptions import InvalidStatus
 from websockets.sync.client import connect
 
 from liansuo.server.client import ClassroomClient
@@ -173,21 +177,38 @@ try:
         print("trainee", li.command("route X XI")["message"])
     with ClassroomClient.instructor(ws, "correct horse") as teacher:
         print("instructor", teacher.command("fault broken-rail IG", seat=2)["message"])
+    base = http.replace("http:", "ws:") + "/ws?width=100&height=30"
+    deadline = time.monotonic() + 60
+    while True:  # the browsers' server starts a moment after the classroom's
+        try:  # and a browser's console starts only after a login on the page
+            with connect(base, open_timeout=10):
+                print("browser console without a login")
+            break
+        except InvalidStatus as exc:
+            print("browser refused before a login: HTTP", exc.response.status_code)
+            break
+        except OSError:
+            if time.monotonic() > deadline:
+                raise
+            time.sleep(0.3)
+    where = urlsplit(http)
+    page = http_client.HTTPConnection(where.hostname, where.port, timeout=30)
+    page.request("POST", "/login", body=urlencode({"role": "trainee", "seat": "2", "name": "Wang"}),
+                 headers={"Content-Type": "application/x-www-form-urlencoded"})
+    answer = page.getresponse()
+    cookie = (answer.getheader("Set-Cookie") or "").split(";")[0]
+    print("login", answer.status, "cookie" if cookie.startswith("liansuo_session=") else "no cookie")
     screen = ""
     deadline = time.monotonic() + 60
-    while "Log in to the classroom" not in screen and time.monotonic() < deadline:
-        try:  # the browsers' server starts a moment after the classroom's
-            with connect(http.replace("http:", "ws:") + "/ws?width=100&height=30", open_timeout=10) as browser:
-                while "Log in to the classroom" not in screen and time.monotonic() < deadline:
-                    try:
-                        data = browser.recv(timeout=1)
-                    except TimeoutError:
-                        continue
-                    screen += data if isinstance(data, str) else data.decode("utf-8", "replace")
-        except OSError:
-            time.sleep(0.3)
+    with connect(base, additional_headers={"Cookie": cookie}, open_timeout=10) as browser:
+        while "seat 2 of the classroom" not in screen and time.monotonic() < deadline:
+            try:
+                data = browser.recv(timeout=1)
+            except TimeoutError:
+                continue
+            screen += data if isinstance(data, str) else data.decode("utf-8", "replace")
     text = re.sub(r"\\x1b\\[[0-9;?]*[A-Za-z]", "", screen)
-    print("browser", "login dialog" if "Log in to the classroom" in text else "no login dialog in:\\n" + text[-3000:])
+    print("browser", "seat 2 console" if "seat 2 of the classroom" in text else "no console in:\\n" + text[-3000:])
 finally:
     proc.terminate()
     proc.wait(10)
@@ -475,7 +496,8 @@ def test_the_classroom_serves_trainees_the_instructor_and_browsers(installed: In
     script.write_text(SERVE_CHECK, encoding="utf-8")
     out = must("liansuo serve --web (python serve_check.py)", [installed.python, script, installed.liansuo],
                installed.work, installed.env)
-    for line in ("trainee route X-XI selected", "instructor fault injected: broken-rail IG", "browser login dialog"):
+    for line in ("trainee route X-XI selected", "instructor fault injected: broken-rail IG",
+                 "browser refused before a login: HTTP 403", "login 303 cookie", "browser seat 2 console"):
         assert line in out, f"liansuo serve --web: no line {line!r} in\n{out}"
 
 
