@@ -1,7 +1,8 @@
 """The connection of a console to the classroom server: one websocket, run by a thread of its own.
 
 The thread runs websockets' asyncio client on an event loop of its own. It keeps what arrives unasked (the newest
-snapshot of the seat shown, the events of every snapshot, the instructor's seat summaries) and hands each reply to
+snapshot of the seat shown, the events of every snapshot by the seat they are of, the instructor's seat summaries)
+and hands each reply to
 the request with the reply's ``id``: each request gets a fresh id, and the server echoes it in the reply
 (docs/classroom.md, "The protocol"). A reply that comes after its request gave up goes to nobody.
 
@@ -114,7 +115,7 @@ class ServerLink:
         self._hello = dict(hello)
         self._lock = threading.Lock()  # the snapshot, events and seats, read by the console's thread
         self._snapshot: dict[str, Any] | None = None
-        self._events: list[list[Any]] = []
+        self._events: dict[int, list[list[Any]]] = {}  # by seat: a snapshot of the seat watched before comes late
         self._seats: list[dict[str, Any]] = []
         # the link's own thread only, on its loop:
         self._ids = itertools.count(1)
@@ -139,12 +140,11 @@ class ServerLink:
         return str(self.welcome.get("role", "trainee"))
 
     # ---- what arrived ---------------------------------------------------------------------------------------------
-    def take(self) -> tuple[dict[str, Any] | None, list[list[Any]]]:
-        """The newest snapshot of the seat shown (None before the first), and the events of every snapshot since
-        the last call."""
+    def take(self) -> tuple[dict[str, Any] | None, int, list[list[Any]]]:
+        """The newest snapshot of the seat shown (None before the first), that seat, and the events of its
+        snapshots since the last call (those of another seat wait until it is shown again)."""
         with self._lock:
-            events, self._events = self._events, []
-            return self._snapshot, events
+            return self._snapshot, self.seat, self._events.pop(self.seat, [])
 
     def seats(self) -> list[dict[str, Any]]:
         """The newest summary of every seat (the instructor's)."""
@@ -177,7 +177,7 @@ class ServerLink:
         reply = self.request({"type": "watch", "seat": seat})
         if reply.get("type") == "ok":
             with self._lock:
-                self.seat, self._snapshot, self._events = seat, None, []
+                self.seat, self._snapshot = seat, None
         return reply
 
     def close(self) -> None:
@@ -276,10 +276,12 @@ class ServerLink:
             return
         kind = msg.get("type")
         if kind == "snapshot":
+            seat = msg.get("seat")
             with self._lock:
-                if msg.get("seat") == self.seat:
+                if seat == self.seat:
                     self._snapshot = msg
-                    self._events += msg.get("events", [])
+                if isinstance(seat, int):
+                    self._events.setdefault(seat, []).extend(msg.get("events", []))
         elif kind == "seats":
             with self._lock:
                 self._seats = list(msg.get("seats", []))
@@ -344,8 +346,8 @@ class Unlinked:
         self.tls = tls
         self.welcome = {"station": lobby.get("station") or {}, "cycle_s": lobby.get("cycle_s", 0.25)}
 
-    def take(self) -> tuple[dict[str, Any] | None, list[list[Any]]]:
-        return None, []
+    def take(self) -> tuple[dict[str, Any] | None, int, list[list[Any]]]:
+        return None, self.seat, []
 
     def seats(self) -> list[dict[str, Any]]:
         return []

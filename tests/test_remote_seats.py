@@ -1,0 +1,79 @@
+"""The instructor's console moving between seats (issue 46): each seat's event log shows that seat's events only,
+once; the exercise picker offers the served station's exercises; the instructor's panel starts an exercise through
+the server. A real classroom server runs in a thread of the test (test_remote.Server); the consoles are driven with
+Textual's Pilot."""
+
+from __future__ import annotations
+
+from collections import Counter
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+from consoletest import SIZE, message, run
+from test_remote import PASSWORD, Server, log, type_line, until
+
+from liansuo.remote.app import RemoteConsoleApp
+from liansuo.remote.dashboard import DashboardScreen, ExercisePicker
+from liansuo.remote.link import ServerLink
+
+
+@pytest.fixture
+def server(tmp_path: Path) -> Iterator[Server]:
+    s = Server(reports=tmp_path / "reports")
+    try:
+        yield s
+    finally:
+        s.close()
+
+
+def event_lines(app: RemoteConsoleApp) -> list[str]:
+    """The log's lines that are the seat's events (those with a time), not the console's own notes."""
+    return [line for line in app.log_panel.lines_text if line[:9].strip().replace(".", "").isdigit()]
+
+
+async def open_seat(pilot: object, app: RemoteConsoleApp, seat: int) -> None:
+    """From the diagram or the dashboard: F3, the seat's row, Enter."""
+    if not isinstance(app.screen, DashboardScreen):
+        await pilot.press("f3")  # type: ignore[attr-defined]
+    dash = app.screen
+    assert isinstance(dash, DashboardScreen)
+    await until(pilot, lambda: len(dash._shown) == 2)
+    dash.query_one("DataTable").move_cursor(row=seat - 1)  # type: ignore[attr-defined]
+    await pilot.press("enter")  # type: ignore[attr-defined]
+    await until(pilot, lambda: not isinstance(app.screen, DashboardScreen) and app.remote.seat == seat
+                and app.remote.live)
+
+
+@run
+async def test_each_seats_log_shows_its_own_events_once(server: Server) -> None:
+    app = RemoteConsoleApp(ServerLink(server.url, {"role": "instructor", "password": PASSWORD}))
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        dash = app.screen
+        assert isinstance(dash, DashboardScreen)
+        await until(pilot, lambda: len(dash._shown) == 2)
+        await pilot.press("e")  # seat 1 is selected
+        assert isinstance(app.screen, ExercisePicker)
+        picker = app.screen
+        await pilot.press(*["down"] * picker.names.index("jiaopei-cancel-route"), "enter")
+        await until(pilot, lambda: server.classroom.seat(1).desk.assessment is not None)
+        await open_seat(pilot, app, 1)
+        await until(pilot, lambda: "X-X3" in log(app))  # the exercise's setup route, seat 1's
+        await open_seat(pilot, app, 2)
+        await type_line(pilot, "fault broken-rail IG")
+        assert "✓" in message(app), message(app)
+        await until(pilot, lambda: "broken" in "\n".join(event_lines(app)))  # seat 2's fault event
+        assert "X-X3" not in log(app), log(app)  # seat 1's events are not in seat 2's log
+        await open_seat(pilot, app, 1)
+        await pilot.pause(1.0)  # snapshots come four times a second
+        seat1 = log(app)
+        assert "broken" not in seat1, seat1  # seat 2's fault is not in seat 1's log
+        twice = [line for line, n in Counter(event_lines(app)).items() if n > 1]
+        assert not twice, seat1
+        assert "X-X3" in seat1 and seat1.count("Cancel a wrong route") == 1, seat1  # its own lines, back once
+        await open_seat(pilot, app, 2)
+        await pilot.pause(1.0)
+        seat2 = log(app)
+        assert "broken" in seat2 and "X-X3" not in seat2, seat2
+        assert not [line for line, n in Counter(event_lines(app)).items() if n > 1], seat2
