@@ -12,7 +12,9 @@ from pathlib import Path
 import pytest
 from consoletest import SIZE, message, run
 from test_remote import PASSWORD, Server, log, type_line, until
+from textual.widgets import Button, Select
 
+from liansuo.classroom.exercise import bundled_exercises, parse_exercise
 from liansuo.remote.app import RemoteConsoleApp
 from liansuo.remote.dashboard import DashboardScreen, ExercisePicker
 from liansuo.remote.link import ServerLink
@@ -77,3 +79,71 @@ async def test_each_seats_log_shows_its_own_events_once(server: Server) -> None:
         seat2 = log(app)
         assert "broken" in seat2 and "X-X3" not in seat2, seat2
         assert not [line for line, n in Counter(event_lines(app)).items() if n > 1], seat2
+
+
+GAOTIE_EXERCISE = """title: Another station's
+station: gaotie
+briefing: not for this classroom
+goals:
+  - description: the route is open
+    expect: [route X X3 open]
+"""
+
+
+@run
+async def test_the_exercise_picker_offers_the_served_stations_exercises_only(server: Server, tmp_path: Path) -> None:
+    own = tmp_path / "exercises"
+    own.mkdir()
+    (own / "gaotie-elsewhere.yaml").write_text(GAOTIE_EXERCISE, encoding="utf-8")
+    (own / "my-cancel.yaml").write_text(Path(parse_exercise("jiaopei-cancel-route").file).read_text("utf-8"),
+                                        encoding="utf-8")
+    server.classroom.exercise_dirs = (own,)
+    app = RemoteConsoleApp(ServerLink(server.url, {"role": "instructor", "password": PASSWORD}))
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        dash = app.screen
+        assert isinstance(dash, DashboardScreen)
+        await until(pilot, lambda: len(dash._shown) == 2)
+        await pilot.press("e")
+        picker = app.screen
+        assert isinstance(picker, ExercisePicker)
+        jiaopei = sorted(p.stem for p in bundled_exercises() if p.stem.startswith("jiaopei-"))
+        assert picker.names == sorted([*jiaopei, "my-cancel"]), picker.names  # no gaotie exercise
+        await pilot.press("escape")
+        assert isinstance(app.screen, DashboardScreen)
+
+
+@run
+async def test_the_instructors_panel_starts_its_exercise_on_the_seat_through_the_server(server: Server) -> None:
+    app = RemoteConsoleApp(ServerLink(server.url, {"role": "instructor", "password": PASSWORD}))
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await open_seat(pilot, app, 2)
+        await pilot.press("f2")
+        await until(pilot, lambda: app.instructor_panel is not None and app.instructor_panel.is_mounted)
+        panel = app.instructor_panel
+        assert panel is not None
+        offered = [p.stem for p in panel.exercises]
+        assert offered and all(n.startswith("jiaopei-") for n in offered), offered  # the served station's only
+        panel.query_one("#ex-file", Select).value = "jiaopei-cancel-route"
+        panel.query_one("#ex-load", Button).press()
+        await until(pilot, lambda: isinstance(app.screen, ExercisePicker))
+        # the local console's own handler (which loads an exercise into a local simulation) did not run after the
+        # remote one: it would have said so on the answer line, over the picker
+        assert "own computer" not in message(app), message(app)
+        await pilot.press("enter")
+        await until(pilot, lambda: server.classroom.seat(2).desk.assessment is not None)
+        assert server.classroom.seat(1).desk.assessment is None
+
+
+@run
+async def test_the_local_consoles_panel_offers_its_stations_exercises_only() -> None:
+    from liansuo.tui.app import ConsoleApp
+
+    app = ConsoleApp("gaotie", paused=True)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await app.set_instructor(True)
+        assert app.instructor_panel is not None
+        offered = [p.stem for p in app.instructor_panel.exercises]
+        assert offered and all(n.startswith("gaotie-") for n in offered), offered

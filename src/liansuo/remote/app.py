@@ -20,7 +20,7 @@ from textual.binding import Binding, BindingType
 
 from liansuo.classroom.roles import INSTRUCTOR
 from liansuo.kit.printable import printable
-from liansuo.remote.dashboard import DashboardScreen, ExerciseChoice, ExercisePicker
+from liansuo.remote.dashboard import DashboardScreen, ExerciseChoice, ExercisePicker, exercise_names
 from liansuo.remote.link import ServerLink, Unlinked
 from liansuo.remote.login import LoginScreen
 from liansuo.remote.sim import ENDED, LOST, NOT_IN, RemoteSimulation
@@ -193,7 +193,14 @@ class RemoteConsoleApp(ConsoleApp):
         self.refresh_views()
         self.say(f"seat {event.seat}: every command goes to this seat; F3 the seats", True)
 
+    def _exercise_files(self) -> list[Path]:
+        """The panel's exercises: those the server may start (its station's), by name."""
+        return [Path(n) for n in exercise_names(self.link)] if isinstance(self.link, ServerLink) else []
+
     def on_instructor_panel_load_exercise(self, event: InstructorPanel.LoadExercise) -> None:
+        """The panel's exercise goes to the server, on this seat (the local console's handler, which loads one into
+        its own simulation, is not for a remote seat: it would refuse it)."""
+        event.prevent_default()
         name = Path(event.path).stem
         self.push_screen(ExercisePicker([name], f"seat {self.seat}"), self._exercise_chosen)
 

@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import Any
 
 from liansuo.classroom.assessment import Assessment, ExerciseSetupError
-from liansuo.classroom.exercise import DIFFICULTIES, bundled_exercises, parse_exercise
+from liansuo.classroom.exercise import DIFFICULTIES, bundled_exercises, exercises_for, parse_exercise
 from liansuo.classroom.report import write_report
 from liansuo.classroom.roles import INSTRUCTOR, command_word, is_typo, refusal
 from liansuo.classroom.snapshot import EventCursor, snapshot
@@ -237,6 +237,13 @@ class Classroom:
 
     def exercise_files(self) -> list[Path]:
         return [*bundled_exercises(), *(p for d in self.exercise_dirs for p in sorted(d.glob("*.yaml")))]
+
+    def station_exercises(self) -> list[str]:
+        """The names of the exercises for this classroom's station (those the instructor may start here); a name in
+        an ``--exercise-dir`` stands for the bundled exercise of that name."""
+        files = {p.stem: p for p in self.exercise_files()}
+        here = self.seat(min(self.seats)).sim.station.id
+        return sorted(p.stem for p in exercises_for(here, files.values()))
 
     def start_exercise(self, seats: list[int], name: str, *, difficulty: int | None = None,
                        seed: int | None = None) -> str:

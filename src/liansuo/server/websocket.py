@@ -179,7 +179,8 @@ class ClassroomServer:
         await ws.send(json.dumps(_replying(ident, {
             "type": "welcome", "role": client.role, "seat": client.seat, "token": client.token,
             "station": self.classroom.station_source(), "cycle_s": seat.sim.cycle_s,
-            "seats": len(self.classroom.seats)})))
+            "seats": len(self.classroom.seats),
+            **({"exercises": self.classroom.station_exercises()} if client.role == INSTRUCTOR else {})})))
         return client
 
     def lobby(self) -> dict[str, Any]:
