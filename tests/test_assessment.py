@@ -342,3 +342,12 @@ def test_a_typo_is_told_as_one_and_costs_nothing_an_instructors_command_does() -
     assert instructor.report()["refused"] == 1
     assert "belongs to the instructor" in instructor.report()["commands"][0]["answer"]
     assert typo.report()["score"]["refused"] == 0 and instructor.report()["score"]["refused"] < 0
+
+
+def test_exercise_run_says_where_the_model_answers_are(capsys: pytest.CaptureFixture[str]) -> None:
+    """Issue 46, item 10: ``--answers`` is required, and its help names the model answers' place, which exists."""
+    with pytest.raises(SystemExit):
+        main(["exercise", "run", "--help"])
+    help_text = " ".join(capsys.readouterr().out.split())
+    assert "tests/data/exercises/NAME.answers" in help_text, help_text
+    assert all((ANSWERS / f"{p.stem}.answers").is_file() for p in bundled_exercises())
