@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from collections import Counter
 from collections.abc import Iterator
+from itertools import pairwise
 from pathlib import Path
 
 import pytest
@@ -18,6 +19,7 @@ from liansuo.classroom.exercise import bundled_exercises, parse_exercise
 from liansuo.remote.app import RemoteConsoleApp
 from liansuo.remote.dashboard import DashboardScreen, ExercisePicker
 from liansuo.remote.link import ServerLink
+from liansuo.server.client import ClassroomClient
 
 
 @pytest.fixture
@@ -147,3 +149,34 @@ async def test_the_local_consoles_panel_offers_its_stations_exercises_only() -> 
         assert app.instructor_panel is not None
         offered = [p.stem for p in app.instructor_panel.exercises]
         assert offered and all(n.startswith("gaotie-") for n in offered), offered
+
+
+def times(app: RemoteConsoleApp) -> list[tuple[float, str]]:
+    """The log's lines that carry a time, with it."""
+    return [(float(line[:9]), line) for line in app.log_panel.lines_text if line[:9].strip().replace(".", "").isdigit()]
+
+
+@run
+async def test_a_seats_new_simulation_is_marked_where_its_times_go_back(server: Server) -> None:
+    app = RemoteConsoleApp(ServerLink(server.url, {"role": "trainee", "seat": 1, "name": "Li"}))
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await until(pilot, lambda: app.remote.live)
+        with ClassroomClient.instructor(server.url, PASSWORD) as teacher:
+            await until(pilot, lambda: app.remote.t > 1.0)
+            assert teacher.request({"type": "exercise", "seats": [1], "name": "jiaopei-cancel-route",
+                                    "seed": 1})["type"] == "ok"
+            await until(pilot, lambda: "route X-X3 locked" in log(app))  # the setup ran 8 s of the new clock
+            await until(pilot, lambda: app.remote.t > 9.0)
+            assert teacher.request({"type": "reset", "seats": [1]})["type"] == "ok"
+            await until(pilot, lambda: "reset by the instructor" in log(app))
+            assert teacher.request({"type": "exercise", "seats": [1], "name": "jiaopei-cancel-route",
+                                    "seed": 1})["type"] == "ok"
+            await until(pilot, lambda: log(app).count("route X-X3 locked") == 2)
+        lines = times(app)
+        marks = [line for _, line in lines if "its clock starts again at 0" in line]
+        assert len(marks) == 3, log(app)  # the exercise, the reset, the exercise again
+        assert "seat 1: exercise 'Cancel a wrong route (取消进路)' started" in marks[0], marks
+        for (before, _), (t, line) in pairwise(lines):
+            if t < before:  # a time going back is where a new simulation is marked, and only there
+                assert "its clock starts again at 0" in line, log(app)

@@ -117,6 +117,7 @@ class ServerLink:
         self._snapshot: dict[str, Any] | None = None
         self._events: dict[int, list[list[Any]]] = {}  # by seat: a snapshot of the seat watched before comes late
         self._seats: list[dict[str, Any]] = []
+        self._runs: dict[int, int] = {}  # by seat: the simulation its last snapshot came from (classroom.Desk.runs)
         # the link's own thread only, on its loop:
         self._ids = itertools.count(1)
         self._pending: dict[int, asyncio.Future[dict[str, Any]]] = {}
@@ -281,7 +282,7 @@ class ServerLink:
                 if seat == self.seat:
                     self._snapshot = msg
                 if isinstance(seat, int):
-                    self._events.setdefault(seat, []).extend(msg.get("events", []))
+                    self._events.setdefault(seat, []).extend([*restarted(msg, self._runs), *msg.get("events", [])])
         elif kind == "seats":
             with self._lock:
                 self._seats = list(msg.get("seats", []))
@@ -308,6 +309,23 @@ class ServerLink:
             return {"type": "error", "message": f"no answer from the classroom server in {self.timeout:g} s"}
         finally:
             self._pending.pop(n, None)  # a reply that comes later goes to nobody
+
+
+RESTART = "restart"  # the kind of the event that marks a seat's new simulation in its log
+
+
+def restarted(snapshot: dict[str, Any], runs: dict[int, int]) -> list[list[Any]]:
+    """The event that marks a new simulation on the snapshot's seat (an exercise started, a reset), before the first
+    events of its clock, which starts at 0 again: so that a log whose times go back says why; [] when it is the
+    simulation of the seat's last snapshot, or the first snapshot seen. ``runs`` is kept by the caller."""
+    seat, run = snapshot["seat"], snapshot.get("run") or {}
+    n = run.get("n")
+    if not isinstance(n, int):
+        return []
+    before, runs[seat] = runs.get(seat), n
+    if before is None or before == n:
+        return []
+    return [[0.0, RESTART, f"seat {seat}: {run.get('why') or 'a new simulation'}; its clock starts again at 0"]]
 
 
 def lobby(url: str, timeout: float = OPEN_TIMEOUT_S, *, tls: ssl.SSLContext | None = None) -> dict[str, Any]:

@@ -47,6 +47,8 @@ class Desk:
     assessment: Assessment | None = None  # the exercise being worked at this desk, scored
     reported: list[Path] = field(default_factory=list)  # the reports written when it ended
     broken: str = ""  # why the desk's clock was stopped by an internal error ('' while it is sound)
+    runs: int = 0  # the simulations the desk has had since the first: each starts its clock at 0 again
+    run_why: str = ""  # why the newest one started
 
 
 @dataclass
@@ -133,7 +135,8 @@ class Classroom:
     def snapshot(self, seat: int, role: str, cursor: EventCursor) -> dict[str, Any]:
         s = self.seat(seat)
         data = snapshot(s.sim, role, cursor)
-        data.update(type="snapshot", seat=seat, paused=s.desk.paused, speed=s.desk.speed, exercise=s.briefing())
+        data.update(type="snapshot", seat=seat, paused=s.desk.paused, speed=s.desk.speed, exercise=s.briefing(),
+                    run={"n": s.desk.runs, "why": s.desk.run_why})
         return data
 
     def summaries(self) -> list[dict[str, Any]]:
@@ -221,11 +224,12 @@ class Classroom:
     def reset(self, seats: list[int]) -> None:
         """A fresh simulation of the station on each seat's desk, without exercise; the seat keeps its trainee."""
         for d in self.desks(seats):
-            self._fresh(d, Simulation(self.station_ref, cycle_s=self.cycle_s))
+            self._fresh(d, Simulation(self.station_ref, cycle_s=self.cycle_s), "reset by the instructor")
 
-    def _fresh(self, d: Desk, sim: Simulation) -> None:
+    def _fresh(self, d: Desk, sim: Simulation, why: str) -> None:
         d.sim.close()
         d.sim, d.debt, d.assessment, d.reported, d.broken = sim, 0.0, None, [], ""
+        d.runs, d.run_why = d.runs + 1, why
         for s in self.seats.values():
             if s.desk is d:
                 s.refused, s.commands = 0, 0
@@ -278,7 +282,7 @@ class Classroom:
                 sim.close()
             raise SeatError(str(exc)) from None
         for d, a in made:
-            self._fresh(d, a.sim)
+            self._fresh(d, a.sim, f"exercise '{ex.title}' started")
             d.assessment = a
         started = sorted(s.number for s in self.seats.values() if any(s.desk is d for d, _ in made))
         return f"exercise '{ex.title}' started on seats {', '.join(map(str, started))}"
