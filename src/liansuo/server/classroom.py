@@ -299,6 +299,17 @@ class Classroom:
                 out += d.reported
         return out
 
+    def stop_unfinished(self, why: str) -> list[Path]:
+        """End every exercise still going, its report saying ``why``, and write those reports (the server stops:
+        the attempts so far are kept). The paths written."""
+        out: list[Path] = []
+        for d in self.desks():
+            if d.assessment is not None and not d.assessment.finished:
+                d.assessment.stop(why)
+                d.reported = self._write(d)
+                out += d.reported
+        return out
+
     def _report_if_ended(self, d: Desk) -> None:
         if d.assessment is not None and d.assessment.finished and not d.reported:
             d.reported = self._write(d)
