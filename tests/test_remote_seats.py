@@ -75,7 +75,7 @@ async def test_each_seats_log_shows_its_own_events_once(server: Server) -> None:
         assert "broken" not in seat1, seat1  # seat 2's fault is not in seat 1's log
         twice = [line for line, n in Counter(event_lines(app)).items() if n > 1]
         assert not twice, seat1
-        assert "X-X3" in seat1 and seat1.count("Cancel a wrong route") == 1, seat1  # its own lines, back once
+        assert "X-X3" in seat1 and seat1.count("lesson   Cancel a wrong route") == 1, seat1  # its own lines, back once
         await open_seat(pilot, app, 2)
         await pilot.pause(1.0)
         seat2 = log(app)
