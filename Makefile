@@ -20,9 +20,10 @@ $(STAMP): pyproject.toml setup.py
 run: $(STAMP)
 	$(BIN)/liansuo tui
 
-# The suite runs on every core (pytest-xdist): many tests wait on servers, consoles and subprocesses.
+# The suite runs on every core (pytest-xdist): many tests wait on servers, consoles and subprocesses. -rs prints why
+# each skipped test was skipped.
 test: $(STAMP)
-	$(BIN)/python -m pytest -n auto --dist worksteal
+	$(BIN)/python -m pytest -n auto --dist worksteal -rs
 	$(BIN)/ruff check .
 	$(BIN)/mypy
 

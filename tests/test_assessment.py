@@ -5,6 +5,7 @@ command line as a trainee's instructor runs it."""
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 import pytest
@@ -12,7 +13,7 @@ import pytest
 from liansuo.classroom.answers import Answer, parse_answers, play
 from liansuo.classroom.assessment import Assessment
 from liansuo.classroom.exercise import bundled_exercises, parse_exercise
-from liansuo.classroom.report import html_report, write_report
+from liansuo.classroom.report import html_report, text_report, write_report
 from liansuo.classroom.roles import TRAINEE, refusal
 from liansuo.classroom.unsafe import fault_release_cause, guide_cause, planted, reach
 from liansuo.cli.main import main
@@ -342,3 +343,31 @@ def test_a_typo_is_told_as_one_and_costs_nothing_an_instructors_command_does() -
     assert instructor.report()["refused"] == 1
     assert "belongs to the instructor" in instructor.report()["commands"][0]["answer"]
     assert typo.report()["score"]["refused"] == 0 and instructor.report()["score"]["refused"] < 0
+
+
+def test_exercise_run_says_where_the_model_answers_are(capsys: pytest.CaptureFixture[str]) -> None:
+    """Issue 46, item 10: ``--answers`` is required, and its help names the model answers' place, which exists."""
+    with pytest.raises(SystemExit):
+        main(["exercise", "run", "--help"])
+    help_text = " ".join(capsys.readouterr().out.split())
+    assert "tests/data/exercises/NAME.answers" in help_text, help_text
+    assert all((ANSWERS / f"{p.stem}.answers").is_file() for p in bundled_exercises())
+
+
+def html_rows(page: str, heading: str) -> list[list[str]]:
+    """The cells of the table under ``<h2>heading</h2>`` in a report page."""
+    table = page.split(f"<h2>{heading}</h2>", 1)[1].split("</table>", 1)[0]
+    return [re.findall(r"<td>(.*?)</td>", row) for row in table.split("<tr>")[2:]]
+
+
+def test_a_goal_has_one_number_of_points_in_the_report_and_they_add_up_to_the_score() -> None:
+    """Issue 46, item 10: the HTML report gave a goal its weight (10 'points') beside a score whose goals part was 45:
+    two different points for one goal. A goal now shows its points of the score, earned of its worth."""
+    a = attempt("jiaopei-cancel-route", [(1, "cancel X")])  # the first goal met, not the second
+    report = a.report()
+    page = html_report(report)
+    goals = html_rows(page, "Goals")
+    score = dict(row[:2] for row in html_rows(page, "Score"))
+    assert [row[1] for row in goals] == ["45 / 45", "0 / 45"], goals  # 90 for the goals (nothing to find), halved
+    assert score["goals"] == "45" == f"{sum(g['worth'] for g in report['goals'] if g['met_at'] is not None):g}"
+    assert "45 / 45 points" in text_report(report) and "0 / 45 points" in text_report(report)

@@ -19,7 +19,7 @@ from typing import Any
 
 from liansuo.classroom.exercise import DIFFICULTIES, Exercise, check_goal
 from liansuo.classroom.roles import command_word, is_typo
-from liansuo.classroom.score import ScoreInputs, score
+from liansuo.classroom.score import ScoreInputs, goal_worth, score
 from liansuo.classroom.unsafe import (
     RED_BAND,
     Planted,
@@ -245,11 +245,14 @@ class Assessment:
             self.diagnoses.append(Diagnosis(t, said, False, ""))
 
     # ---- results ----------------------------------------------------------------------------------------------
-    def _score(self) -> dict[str, float]:
+    def _inputs(self) -> ScoreInputs:
         goals = tuple((g.points, at) for g, at in zip(self.exercise.goals, self.goal_met_at, strict=True))
         wrong = sum(not d.correct for d in self.diagnoses)
-        return score(self.exercise.scoring, ScoreInputs(goals, tuple(self.diagnosed_at), self.refused, len(self.unsafe),
-                                                        wrong, self.exercise.time_limit))
+        return ScoreInputs(goals, tuple(self.diagnosed_at), self.refused, len(self.unsafe), wrong,
+                           self.exercise.time_limit)
+
+    def _score(self) -> dict[str, float]:
+        return score(self.exercise.scoring, self._inputs())
 
     def sealed_uses(self) -> dict[str, int]:
         """The sealed buttons the trainee used (铅封计数 since the exercise began; the setup's are not counted)."""
@@ -284,8 +287,11 @@ class Assessment:
                          for f, at in zip(self.findings, self.diagnosed_at, strict=True)],
             "diagnoses": [{"t": d.t, "diagnosis": d.line, "correct": d.correct, "finding": d.finding}
                           for d in self.diagnoses],
-            "goals": [{"description": g.description, "expect": list(g.expect), "points": g.points, "met_at": at}
-                      for g, at in zip(ex.goals, self.goal_met_at, strict=True)],
+            # points: the goal's weight among the goals (the exercise's); worth: its share of the score's goals part
+            "goals": [{"description": g.description, "expect": list(g.expect), "points": g.points, "worth": worth,
+                       "met_at": at}
+                      for g, at, worth in zip(ex.goals, self.goal_met_at, goal_worth(ex.scoring, self._inputs()),
+                                              strict=True)],
             "all_goals_met": bool(self.goal_met_at) and all(t is not None for t in self.goal_met_at),
             "sealed_uses": self.sealed_uses(),
             "score": self._score(),

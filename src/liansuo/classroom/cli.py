@@ -32,7 +32,9 @@ def register(add: Add) -> None:
     run.add_argument("exercise", metavar="NAME|FILE", help="a bundled exercise by name, or an exercise file")
     run.add_argument("--answers", required=True, metavar="FILE",
                      help="the trainee's answers, one a line: the time since the start, then the command "
-                          "('30s route X X3')")
+                          "('30s route X X3'); the model answers of the bundled exercises are in liansuo's source "
+                          "repository, tests/data/exercises/NAME.answers (not installed, so that a trainee's "
+                          "machine does not hold them)")
     run.add_argument("--seed", type=int, default=1, metavar="N", help="the seed of the pool's draw (default 1)")
     run.add_argument("--difficulty", type=int, choices=(1, 2, 3), metavar="D",
                      help="1 easy, 2 medium, 3 hard (default: the exercise's own)")

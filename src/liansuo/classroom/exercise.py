@@ -28,6 +28,7 @@ Goals are checked with the command language's own ``expect`` lines, which read t
 from __future__ import annotations
 
 import random
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 from importlib.resources import files
 from pathlib import Path
@@ -38,6 +39,7 @@ from liansuo.kit.source import Diagnostic, Source, StationError
 from liansuo.simulation.diagnosis import DIAGNOSIS_KINDS
 from liansuo.simulation.sim import LANGUAGE, Simulation
 from liansuo.stations.library import bundled, resolve_from
+from liansuo.stations.loader import load
 from liansuo.stations.validation import validate
 
 DIFFICULTIES = {1: "easy", 2: "medium", 3: "hard"}
@@ -200,6 +202,23 @@ def check_goal(sim: Simulation, ex: Exercise, met: set[int] | None = None) -> Go
         now.append(holds)
         lines += results
     return GoalCheck(bool(now) and all(now), lines, now)
+
+
+def exercises_for(station_id: str, paths: Iterable[Path]) -> list[Path]:
+    """Those of ``paths`` that are exercises for the station ``station_id`` (one that cannot be read is left out:
+    starting it says why)."""
+    ids: dict[str, str] = {}  # a station's reference: its id
+    out: list[Path] = []
+    for p in paths:
+        try:
+            ref = parse_exercise(p).station_ref()
+            if ref not in ids:
+                ids[ref] = load(ref).id
+        except (StationError, OSError):
+            continue
+        if ids[ref] == station_id:
+            out.append(p)
+    return out
 
 
 def bundled_exercises() -> list[Path]:

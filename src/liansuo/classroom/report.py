@@ -29,6 +29,14 @@ def _faults(report: dict[str, Any]) -> list[str]:
     return [*f["setup"], *f["fixed"], *f["drawn"]]
 
 
+def _earned(goal: dict[str, Any]) -> str:
+    """A goal's points of the score: earned of its worth (a report written before 'worth' was: its weight)."""
+    worth = goal.get("worth")
+    if worth is None:
+        return f"weight {goal['points']:g}"
+    return f"{worth if goal['met_at'] is not None else 0:g} / {worth:g}"
+
+
 def _score_rows(report: dict[str, Any]) -> list[tuple[str, str]]:
     sc = report["score"]
     return [("goals", f"{sc['goals']:g}"), ("diagnosis", f"{sc['diagnosis']:g}"), ("time", f"{sc['time']:g}"),
@@ -49,7 +57,7 @@ def text_report(report: dict[str, Any]) -> str:
     for g in report["goals"]:
         mark = f"met at {_t(g['met_at'])}" if g["met_at"] is not None else "not met"
         out.append(f"  [{'x' if g['met_at'] is not None else ' '}] {g['description'] or '; '.join(g['expect'])}"
-                   f" ({mark})")
+                   f" ({mark}; {_earned(g)} points)")
     out += ["", "Findings:"] + [
         f"  [{'x' if f['diagnosed_at'] is not None else ' '}] {f['finding']}: "
         f"{'diagnosed at ' + _t(f['diagnosed_at']) if f['diagnosed_at'] is not None else 'not diagnosed'}"
@@ -80,8 +88,8 @@ def html_report(report: dict[str, Any]) -> str:
     ex = report["exercise"]
     sections = [
         ("Score", ["part", "points"], [[a, b] for a, b in _score_rows(report)]),
-        ("Goals", ["goal", "points", "met at"], [
-            [g["description"] or "; ".join(g["expect"]), f"{g['points']:g}", _t(g["met_at"])]
+        ("Goals", ["goal", "points of the score (earned / worth)", "met at"], [
+            [g["description"] or "; ".join(g["expect"]), _earned(g), _t(g["met_at"])]
             for g in report["goals"]]),
         ("Findings", ["finding", "diagnosed at"], [[f["finding"], _t(f["diagnosed_at"])] for f in report["findings"]]),
         ("Diagnoses", ["time", "diagnosis", "correct"], [

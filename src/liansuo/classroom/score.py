@@ -38,10 +38,22 @@ def _share(t: float, full_until: float, limit: float, floor: float) -> float:
     return max(floor, 1.0 - (1.0 - floor) * (t - full_until) / (limit - full_until))
 
 
+def _goals_max(rules: Scoring, given: ScoreInputs) -> float:
+    return rules.goals + (0.0 if given.findings else rules.diagnosis)
+
+
+def goal_worth(rules: Scoring, given: ScoreInputs) -> list[float]:
+    """What each goal is worth in the score's ``goals`` part: its share of G by its ``points`` (a weight among the
+    goals, not points of the score), rounded as the parts are."""
+    total_points = sum(p for p, _ in given.goal_points)
+    return [round(_goals_max(rules, given) * p / total_points, 1) if total_points else 0.0
+            for p, _ in given.goal_points]
+
+
 def score(rules: Scoring, given: ScoreInputs) -> dict[str, float]:
     """The score's parts and total: ``goals``, ``diagnosis``, ``time`` (earned), ``refused``, ``unsafe``,
     ``wrong_diagnosis`` (lost, as negative numbers), ``total`` and ``max``."""
-    goals_max = rules.goals + (0.0 if given.findings else rules.diagnosis)
+    goals_max = _goals_max(rules, given)
     diagnosis_max = rules.diagnosis if given.findings else 0.0
     total_points = sum(p for p, _ in given.goal_points)
     met_points = sum(p for p, at in given.goal_points if at is not None)

@@ -11,6 +11,7 @@ seat's diagram, where every command goes to that seat, and F3 goes back.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, ClassVar
 
@@ -19,12 +20,13 @@ from textual.binding import Binding, BindingType
 
 from liansuo.classroom.roles import INSTRUCTOR
 from liansuo.kit.printable import printable
-from liansuo.remote.dashboard import DashboardScreen, ExerciseChoice, ExercisePicker
+from liansuo.remote.dashboard import DashboardScreen, ExerciseChoice, ExercisePicker, exercise_names
 from liansuo.remote.link import ServerLink, Unlinked
 from liansuo.remote.login import LoginScreen
 from liansuo.remote.sim import ENDED, LOST, NOT_IN, RemoteSimulation
 from liansuo.tui.app import SPEEDS, ConsoleApp
 from liansuo.tui.instructor import InstructorPanel
+from liansuo.tui.panels import EventReader
 
 
 class RemoteConsoleApp(ConsoleApp):
@@ -47,6 +49,7 @@ class RemoteConsoleApp(ConsoleApp):
         self._ended = False
         self._lesson: tuple[str, str] | None = None  # the exercise last shown (title, briefing)
         self._lesson_ended = False
+        self._away: dict[int, SeatLog] = {}  # the log of each seat the instructor watched before, kept to show again
 
     @property
     def logged_in(self) -> bool:
@@ -115,6 +118,8 @@ class RemoteConsoleApp(ConsoleApp):
 
     def follow_lesson(self) -> None:
         """An exercise started on the seat: its briefing and goals in the log; ended: how, and the score."""
+        if not self.remote.live:  # the fail-safe picture tells no exercise: the seat's is told as it was
+            return
         lesson = self.remote.lesson
         key = None if lesson is None else (lesson["title"], lesson["briefing"])
         if key != self._lesson:
@@ -170,19 +175,32 @@ class RemoteConsoleApp(ConsoleApp):
             self.push_screen(DashboardScreen(self.link))
 
     def on_dashboard_screen_open(self, event: DashboardScreen.Open) -> None:
-        """The dashboard opens a seat: watch it, and show it from a fresh log."""
+        """The dashboard opens a seat: watch it, and show its own log (kept from when it was watched before)."""
+        was = self.seat
         reply = self.link.watch(event.seat)
         if reply.get("type") != "ok":
             self.say(str(reply.get("message", reply)), False)
             return
+        if event.seat != was:
+            self._away[was] = SeatLog(self.log_panel.entries(), self.events, self._lesson, self._lesson_ended)
+            back = self._away.pop(event.seat, None)
+            if back is None:
+                back = SeatLog([(f"{'':9} {'seat':8} seat {event.seat}", "bold #d0a0ff")], EventReader(), None, False)
+            self.log_panel.show(back.lines)
+            self.events, self._lesson, self._lesson_ended = back.reader, back.lesson, back.lesson_ended
+            self.acknowledged.clear()
         self.remote.step()
-        self.events.reset()
-        self.acknowledged.clear()
-        self.log_panel.add(f"{'':9} {'seat':8} seat {event.seat}", "bold #d0a0ff")
         self.refresh_views()
         self.say(f"seat {event.seat}: every command goes to this seat; F3 the seats", True)
 
+    def _exercise_files(self) -> list[Path]:
+        """The panel's exercises: those the server may start (its station's), by name."""
+        return [Path(n) for n in exercise_names(self.link)] if isinstance(self.link, ServerLink) else []
+
     def on_instructor_panel_load_exercise(self, event: InstructorPanel.LoadExercise) -> None:
+        """The panel's exercise goes to the server, on this seat (the local console's handler, which loads one into
+        its own simulation, is not for a remote seat: it would refuse it)."""
+        event.prevent_default()
         name = Path(event.path).stem
         self.push_screen(ExercisePicker([name], f"seat {self.seat}"), self._exercise_chosen)
 
@@ -204,6 +222,17 @@ class RemoteConsoleApp(ConsoleApp):
         elif not self.link.connected:
             out.append(f"│ {ENDED if self.link.ended else LOST} ", style="bold #ffffff on #c00000")
         return out
+
+
+@dataclass
+class SeatLog:
+    """A seat's event log while the instructor watches another: its lines, where its events were read to, and the
+    exercise it last told."""
+
+    lines: list[tuple[str, str]]
+    reader: EventReader
+    lesson: tuple[str, str] | None
+    lesson_ended: bool
 
 
 def lesson_text(lesson: dict[str, Any]) -> str:

@@ -54,9 +54,10 @@ def hello(args: argparse.Namespace) -> dict[str, Any] | None:
 
 
 def cmd_connect(args: argparse.Namespace) -> int:
+    from liansuo.kit.arguments import unwritable
     from liansuo.remote.link import LinkError, ServerLink, Unlinked, lobby
     from liansuo.server.tls import TLSError, client_context
-    from liansuo.tui.cli import closed
+    from liansuo.tui.cli import run_logged
 
     try:
         greeting = hello(args)
@@ -64,6 +65,8 @@ def cmd_connect(args: argparse.Namespace) -> int:
             raise LoginError(f"--connect takes a websocket address, ws://HOST:PORT or wss://HOST:PORT, not "
                              f"{args.connect!r}")
         tls = client_context(args.connect, args.cafile)
+        if args.log and (why := unwritable(Path(args.log), "--log")):
+            raise LoginError(why)
     except (LoginError, TLSError) as exc:
         return refuse("tui", str(exc), Exit.USAGE)
     try:
@@ -75,7 +78,6 @@ def cmd_connect(args: argparse.Namespace) -> int:
 
     app = RemoteConsoleApp(link, mute=args.mute)
     try:
-        app.run()
+        return run_logged(app, "tui", args.log)
     finally:
         link.close()
-    return closed(app, "tui")

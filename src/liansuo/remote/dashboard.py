@@ -21,7 +21,6 @@ from textual.message import Message
 from textual.screen import ModalScreen, Screen
 from textual.widgets import Button, DataTable, Footer, Label, OptionList, Select, Static
 
-from liansuo.classroom.exercise import bundled_exercises
 from liansuo.kit.printable import printable
 from liansuo.remote.link import ServerLink
 from liansuo.tui.panels import clock_text
@@ -62,10 +61,10 @@ class ExerciseChoice:
                 "seed": random.randrange(2**31)}
 
 
-def exercise_names(station: str) -> list[str]:
-    """The bundled exercises, those for ``station`` first."""
-    names = [p.stem for p in bundled_exercises()]
-    return sorted(names, key=lambda n: (not n.startswith(f"{station}-"), n))
+def exercise_names(link: ServerLink) -> list[str]:
+    """The exercises the server may start: those for its station, bundled or from its ``--exercise-dir`` (the
+    instructor's welcome lists them)."""
+    return [str(n) for n in link.welcome.get("exercises", [])]
 
 
 class ExercisePicker(ModalScreen[ExerciseChoice | None]):
@@ -238,12 +237,17 @@ class DashboardScreen(Screen[None]):
             return
         station = str(self.link.welcome.get("station", {}).get("name", ""))
         where = "every seat" if seats == "all" else f"seat {seats[0]}"
+        names = exercise_names(self.link)
+        if not names:
+            self.say(f"this server has no exercise for {station}: give it some with 'liansuo serve --exercise-dir "
+                     "DIR'", False)
+            return
 
         def chosen(choice: ExerciseChoice | None) -> None:
             if choice is not None:
                 self._send(choice.message(seats))
 
-        self.app.push_screen(ExercisePicker(exercise_names(station), where), chosen)
+        self.app.push_screen(ExercisePicker(names, where), chosen)
 
     def on_button_pressed(self, event: Button.Pressed) -> None:
         action = (event.button.id or "").removeprefix("b-")

@@ -1,7 +1,8 @@
 """The connection of a console to the classroom server: one websocket, run by a thread of its own.
 
 The thread runs websockets' asyncio client on an event loop of its own. It keeps what arrives unasked (the newest
-snapshot of the seat shown, the events of every snapshot, the instructor's seat summaries) and hands each reply to
+snapshot of the seat shown, the events of every snapshot by the seat they are of, the instructor's seat summaries)
+and hands each reply to
 the request with the reply's ``id``: each request gets a fresh id, and the server echoes it in the reply
 (docs/classroom.md, "The protocol"). A reply that comes after its request gave up goes to nobody.
 
@@ -114,8 +115,9 @@ class ServerLink:
         self._hello = dict(hello)
         self._lock = threading.Lock()  # the snapshot, events and seats, read by the console's thread
         self._snapshot: dict[str, Any] | None = None
-        self._events: list[list[Any]] = []
+        self._events: dict[int, list[list[Any]]] = {}  # by seat: a snapshot of the seat watched before comes late
         self._seats: list[dict[str, Any]] = []
+        self._runs: dict[int, int] = {}  # by seat: the simulation its last snapshot came from (classroom.Desk.runs)
         # the link's own thread only, on its loop:
         self._ids = itertools.count(1)
         self._pending: dict[int, asyncio.Future[dict[str, Any]]] = {}
@@ -139,12 +141,11 @@ class ServerLink:
         return str(self.welcome.get("role", "trainee"))
 
     # ---- what arrived ---------------------------------------------------------------------------------------------
-    def take(self) -> tuple[dict[str, Any] | None, list[list[Any]]]:
-        """The newest snapshot of the seat shown (None before the first), and the events of every snapshot since
-        the last call."""
+    def take(self) -> tuple[dict[str, Any] | None, int, list[list[Any]]]:
+        """The newest snapshot of the seat shown (None before the first), that seat, and the events of its
+        snapshots since the last call (those of another seat wait until it is shown again)."""
         with self._lock:
-            events, self._events = self._events, []
-            return self._snapshot, events
+            return self._snapshot, self.seat, self._events.pop(self.seat, [])
 
     def seats(self) -> list[dict[str, Any]]:
         """The newest summary of every seat (the instructor's)."""
@@ -177,7 +178,7 @@ class ServerLink:
         reply = self.request({"type": "watch", "seat": seat})
         if reply.get("type") == "ok":
             with self._lock:
-                self.seat, self._snapshot, self._events = seat, None, []
+                self.seat, self._snapshot = seat, None
         return reply
 
     def close(self) -> None:
@@ -276,10 +277,12 @@ class ServerLink:
             return
         kind = msg.get("type")
         if kind == "snapshot":
+            seat = msg.get("seat")
             with self._lock:
-                if msg.get("seat") == self.seat:
+                if seat == self.seat:
                     self._snapshot = msg
-                    self._events += msg.get("events", [])
+                if isinstance(seat, int):
+                    self._events.setdefault(seat, []).extend([*restarted(msg, self._runs), *msg.get("events", [])])
         elif kind == "seats":
             with self._lock:
                 self._seats = list(msg.get("seats", []))
@@ -306,6 +309,23 @@ class ServerLink:
             return {"type": "error", "message": f"no answer from the classroom server in {self.timeout:g} s"}
         finally:
             self._pending.pop(n, None)  # a reply that comes later goes to nobody
+
+
+RESTART = "restart"  # the kind of the event that marks a seat's new simulation in its log
+
+
+def restarted(snapshot: dict[str, Any], runs: dict[int, int]) -> list[list[Any]]:
+    """The event that marks a new simulation on the snapshot's seat (an exercise started, a reset), before the first
+    events of its clock, which starts at 0 again: so that a log whose times go back says why; [] when it is the
+    simulation of the seat's last snapshot, or the first snapshot seen. ``runs`` is kept by the caller."""
+    seat, run = snapshot["seat"], snapshot.get("run") or {}
+    n = run.get("n")
+    if not isinstance(n, int):
+        return []
+    before, runs[seat] = runs.get(seat), n
+    if before is None or before == n:
+        return []
+    return [[0.0, RESTART, f"seat {seat}: {run.get('why') or 'a new simulation'}; its clock starts again at 0"]]
 
 
 def lobby(url: str, timeout: float = OPEN_TIMEOUT_S, *, tls: ssl.SSLContext | None = None) -> dict[str, Any]:
@@ -344,8 +364,8 @@ class Unlinked:
         self.tls = tls
         self.welcome = {"station": lobby.get("station") or {}, "cycle_s": lobby.get("cycle_s", 0.25)}
 
-    def take(self) -> tuple[dict[str, Any] | None, list[list[Any]]]:
-        return None, []
+    def take(self) -> tuple[dict[str, Any] | None, int, list[list[Any]]]:
+        return None, self.seat, []
 
     def seats(self) -> list[dict[str, Any]]:
         return []

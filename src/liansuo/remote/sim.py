@@ -12,6 +12,7 @@ turnout without indication, no route; an alarm says why, and every command is re
 from __future__ import annotations
 
 from collections import deque
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -57,14 +58,14 @@ class FaultText:
 
 
 class LiveView(SnapshotView):
-    """A snapshot's answers, with the events of every snapshot received so far (newest last)."""
+    """A snapshot's answers, with the events of every snapshot of the seat shown received so far (newest last)."""
 
-    def __init__(self, station_id: str, data: dict[str, Any], log: deque[Event]) -> None:
+    def __init__(self, station_id: str, data: dict[str, Any], log: Callable[[], deque[Event]]) -> None:
         super().__init__(station_id, data)
         self._log = log
 
     def events(self) -> deque[Event]:
-        return self._log
+        return self._log()
 
 
 class RemoteField:
@@ -125,7 +126,7 @@ class RemoteSimulation:
         self.speed = 1.0
         self.live = False  # showing the server's state (False: the fail-safe picture, or nothing received yet)
         self.seat = link.seat
-        self._log: deque[Event] = deque(maxlen=MAX_EVENTS)
+        self._logs: dict[int, deque[Event]] = {}  # each seat's events, kept while the instructor watches another
         self._show(dark(self.station, 0.0, LOST if isinstance(link, ServerLink) else NOT_IN))
         self.live = False
 
@@ -133,12 +134,16 @@ class RemoteSimulation:
         """Logged in: the seat's state from now on comes through ``link``."""
         self.link, self.seat = link, link.seat
 
+    def log(self, seat: int) -> deque[Event]:
+        """The events of ``seat`` received so far (newest last)."""
+        return self._logs.setdefault(seat, deque(maxlen=MAX_EVENTS))
+
     @property
     def t(self) -> float:
         return self.view.t
 
     def _show(self, data: dict[str, Any]) -> None:
-        self.view = LiveView(self.station.id, data, self._log)
+        self.view = LiveView(self.station.id, data, lambda: self.log(self.seat))
         self.field = RemoteField(self.view)
         self.lesson: dict[str, Any] | None = data.get("exercise")  # what the trainee is told of the exercise
         self.paused = bool(data.get("paused", self.paused))
@@ -148,10 +153,13 @@ class RemoteSimulation:
     # ---- the two things the console does ------------------------------------------------------------------------
     def step(self) -> None:
         """Show the newest snapshot (the server runs the clock); the fail-safe picture while the link is down."""
-        data, events = self.link.take()
-        self._log.extend(Event(float(t), str(k), str(x)) for t, k, x in events)
-        if self.seat != self.link.seat:  # the instructor watches another seat: its state only from now on
-            self.seat = self.link.seat
+        data, seat, events = self.link.take()
+        self.log(seat).extend(Event(float(t), str(k), str(x)) for t, k, x in events)
+        if seat != self.seat:  # the instructor watches another seat: its state and events only from now on
+            self.seat = seat
+            if self.live:  # not the seat watched before's state, shown as this one's
+                self._show(dark(self.station, self.t, f"waiting for the state of seat {seat}"))
+                self.live = False
         if not self.link.connected:
             if self.live:
                 self._show(dark(self.station, self.t))

@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import Any
 
 from liansuo.classroom.assessment import Assessment, ExerciseSetupError
-from liansuo.classroom.exercise import DIFFICULTIES, bundled_exercises, parse_exercise
+from liansuo.classroom.exercise import DIFFICULTIES, bundled_exercises, exercises_for, parse_exercise
 from liansuo.classroom.report import write_report
 from liansuo.classroom.roles import INSTRUCTOR, command_word, is_typo, refusal
 from liansuo.classroom.snapshot import EventCursor, snapshot
@@ -47,6 +47,8 @@ class Desk:
     assessment: Assessment | None = None  # the exercise being worked at this desk, scored
     reported: list[Path] = field(default_factory=list)  # the reports written when it ended
     broken: str = ""  # why the desk's clock was stopped by an internal error ('' while it is sound)
+    runs: int = 0  # the simulations the desk has had since the first: each starts its clock at 0 again
+    run_why: str = ""  # why the newest one started
 
 
 @dataclass
@@ -133,7 +135,8 @@ class Classroom:
     def snapshot(self, seat: int, role: str, cursor: EventCursor) -> dict[str, Any]:
         s = self.seat(seat)
         data = snapshot(s.sim, role, cursor)
-        data.update(type="snapshot", seat=seat, paused=s.desk.paused, speed=s.desk.speed, exercise=s.briefing())
+        data.update(type="snapshot", seat=seat, paused=s.desk.paused, speed=s.desk.speed, exercise=s.briefing(),
+                    run={"n": s.desk.runs, "why": s.desk.run_why})
         return data
 
     def summaries(self) -> list[dict[str, Any]]:
@@ -221,11 +224,12 @@ class Classroom:
     def reset(self, seats: list[int]) -> None:
         """A fresh simulation of the station on each seat's desk, without exercise; the seat keeps its trainee."""
         for d in self.desks(seats):
-            self._fresh(d, Simulation(self.station_ref, cycle_s=self.cycle_s))
+            self._fresh(d, Simulation(self.station_ref, cycle_s=self.cycle_s), "reset by the instructor")
 
-    def _fresh(self, d: Desk, sim: Simulation) -> None:
+    def _fresh(self, d: Desk, sim: Simulation, why: str) -> None:
         d.sim.close()
         d.sim, d.debt, d.assessment, d.reported, d.broken = sim, 0.0, None, [], ""
+        d.runs, d.run_why = d.runs + 1, why
         for s in self.seats.values():
             if s.desk is d:
                 s.refused, s.commands = 0, 0
@@ -237,6 +241,13 @@ class Classroom:
 
     def exercise_files(self) -> list[Path]:
         return [*bundled_exercises(), *(p for d in self.exercise_dirs for p in sorted(d.glob("*.yaml")))]
+
+    def station_exercises(self) -> list[str]:
+        """The names of the exercises for this classroom's station (those the instructor may start here); a name in
+        an ``--exercise-dir`` stands for the bundled exercise of that name."""
+        files = {p.stem: p for p in self.exercise_files()}
+        here = self.seat(min(self.seats)).sim.station.id
+        return sorted(p.stem for p in exercises_for(here, files.values()))
 
     def start_exercise(self, seats: list[int], name: str, *, difficulty: int | None = None,
                        seed: int | None = None) -> str:
@@ -271,7 +282,7 @@ class Classroom:
                 sim.close()
             raise SeatError(str(exc)) from None
         for d, a in made:
-            self._fresh(d, a.sim)
+            self._fresh(d, a.sim, f"exercise '{ex.title}' started")
             d.assessment = a
         started = sorted(s.number for s in self.seats.values() if any(s.desk is d for d, _ in made))
         return f"exercise '{ex.title}' started on seats {', '.join(map(str, started))}"
@@ -285,6 +296,17 @@ class Classroom:
                 d.assessment.stop()
                 if not d.reported:
                     d.reported = self._write(d)
+                out += d.reported
+        return out
+
+    def stop_unfinished(self, why: str) -> list[Path]:
+        """End every exercise still going, its report saying ``why``, and write those reports (the server stops:
+        the attempts so far are kept). The paths written."""
+        out: list[Path] = []
+        for d in self.desks():
+            if d.assessment is not None and not d.assessment.finished:
+                d.assessment.stop(why)
+                d.reported = self._write(d)
                 out += d.reported
         return out
 

@@ -18,6 +18,7 @@ from liansuo.kit.exitcodes import Exit, bad_input, refuse
 from liansuo.kit.source import StationError
 
 if TYPE_CHECKING:
+    from liansuo.server.classroom import Classroom
     from liansuo.server.websocket import ClassroomServer
 
 Handler = Callable[[argparse.Namespace], int]
@@ -135,8 +136,24 @@ def cmd_serve(args: argparse.Namespace) -> int:
     except (KeyboardInterrupt, asyncio.CancelledError):
         pass
     finally:
+        _keep_attempts(classroom)
         classroom.close()
     return 0
+
+
+STOPPED = "stopped: the server was stopped before the end"
+
+
+def _keep_attempts(classroom: Classroom) -> None:
+    """The server stops (ctrl+c, SIGTERM, an error): each exercise still going gets its report, marked as stopped."""
+    try:
+        written = classroom.stop_unfinished(STOPPED)
+    except Exception as exc:  # the reports are worth a try, never a traceback over the server's own ending
+        print(f"liansuo serve: the unfinished exercises' reports could not be written: {exc}", file=sys.stderr)
+        return
+    if written:
+        print(f"liansuo serve: stopped; reports of the exercises it stopped ({STOPPED}): "
+              f"{', '.join(str(p) for p in written)}", flush=True)
 
 
 def _free(host: str, port: int) -> int:

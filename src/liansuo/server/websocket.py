@@ -66,7 +66,14 @@ class Client:
     role: str
     seat: int  # the trainee's seat, or the seat the instructor watches
     token: str = ""
-    cursor: EventCursor = field(default_factory=EventCursor)
+    # where each seat's event stream stands for this client: the instructor watching a seat again gets the events
+    # since they last saw it, never its earlier ones twice (a seat reset or given an exercise has a new simulation,
+    # whose events the cursor sends from its first)
+    cursors: dict[int, EventCursor] = field(default_factory=dict)
+
+    @property
+    def cursor(self) -> EventCursor:
+        return self.cursors.setdefault(self.seat, EventCursor())
 
 
 class ClassroomServer:
@@ -172,7 +179,8 @@ class ClassroomServer:
         await ws.send(json.dumps(_replying(ident, {
             "type": "welcome", "role": client.role, "seat": client.seat, "token": client.token,
             "station": self.classroom.station_source(), "cycle_s": seat.sim.cycle_s,
-            "seats": len(self.classroom.seats)})))
+            "seats": len(self.classroom.seats),
+            **({"exercises": self.classroom.station_exercises()} if client.role == INSTRUCTOR else {})})))
         return client
 
     def lobby(self) -> dict[str, Any]:
@@ -255,7 +263,7 @@ class ClassroomServer:
             raise SeatError(f"'{msg.type}' is the instructor's: a trainee sends commands only")
         if isinstance(msg, WatchMessage):
             self.classroom.seat(msg.seat)
-            client.seat, client.cursor = msg.seat, EventCursor()
+            client.seat = msg.seat
             return {"type": "ok", "message": f"watching seat {msg.seat}"}
         seats = list(self.classroom.seats) if msg.seats == "all" else [int(s) for s in msg.seats]
         if isinstance(msg, ClockMessage):
@@ -265,7 +273,6 @@ class ClassroomServer:
                                              f"{msg.action or 'speed'} {'' if msg.speed is None else msg.speed}"}
         if isinstance(msg, ExerciseMessage):
             said = self.classroom.start_exercise(seats, msg.name, difficulty=msg.difficulty, seed=msg.seed)
-            client.cursor = EventCursor()
             return {"type": "ok", "message": said}
         if isinstance(msg, StopMessage):
             written = self.classroom.stop_exercise(seats)
@@ -278,7 +285,6 @@ class ClassroomServer:
                     self._later(ws.close(1008, f"the instructor freed seat {c.seat}"))
             return {"type": "ok", "message": f"seats {', '.join(map(str, seats))} freed: a new trainee may take them"}
         self.classroom.reset(seats)
-        client.cursor = EventCursor()
         return {"type": "ok", "message": f"seats {', '.join(map(str, seats))} reset"}
 
     def _later(self, work: Coroutine[Any, Any, None]) -> None:

@@ -23,6 +23,7 @@ from liansuo.stations.station import Station
 if TYPE_CHECKING:
     from liansuo.simulation.fieldlink import FieldLink
     from liansuo.simulation.recording.file import Recording
+    from liansuo.tui.logfile import LogFile
     from liansuo.tui.safeapp import SafeApp
 
 Handler = Callable[[argparse.Namespace], int]
@@ -45,6 +46,9 @@ def register(add: Add, connect: Handler | None = None) -> None:
                          "(or a password); else LIANSUO_INSTRUCTOR_PASSWORD; never on the command line, where ps "
                          "shows it")
     sp.add_argument("--mute", action="store_true", help="start with the alarm bell muted (m or 'unmute' turns it on)")
+    sp.add_argument("--log", metavar="FILE",
+                    help="append warnings and internal errors (with their tracebacks) to FILE as they happen; "
+                         "'2> FILE' would take the screen, which Textual draws on stderr")
     fld = sp.add_argument_group("field mode", "the interlocking against field equipment over Modbus TCP "
                                               "('liansuo docs field-mode')")
     fld.add_argument("--field", metavar="HOST:PORT",
@@ -103,6 +107,8 @@ def cmd_tui(args: argparse.Namespace) -> int:
         return bad_input(station)
     if args.record and (why := unwritable(Path(args.record), "--record")):
         return refuse("tui", why, Exit.USAGE)
+    if args.log and (why := unwritable(Path(args.log), "--log")):
+        return refuse("tui", why, Exit.USAGE)
     if args.exercise:
         from liansuo.classroom.exercise import parse_exercise
 
@@ -132,8 +138,22 @@ def cmd_tui(args: argparse.Namespace) -> int:
                          field=field[0] if field else None, changeover_hash=field[1] if field else None)
     except OSError as exc:
         return refuse("tui", str(exc), Exit.BAD_INPUT)
-    app.run()
-    return closed(app, "tui")
+    return run_logged(app, "tui", args.log)
+
+
+def run_logged(app: SafeApp, command: str, log: str | None) -> int:
+    """Run the console, with its log file open (``--log``); its exit status (:func:`closed`)."""
+    if log is None:
+        app.run()
+        return closed(app, command)
+    from liansuo.tui.logfile import LogFile
+
+    try:
+        with LogFile(log, command) as logfile:
+            app.run()
+            return closed(app, command, logfile)
+    except OSError as exc:
+        return refuse(command, f"cannot write the log {log}: {exc.strerror or exc}", Exit.USAGE)
 
 
 def _field(args: argparse.Namespace, station: Station) -> tuple[FieldLink, str] | int | None:
@@ -185,10 +205,14 @@ def _connect(args: argparse.Namespace) -> int:
     return handler(args)
 
 
-def closed(app: SafeApp, command: str) -> int:
-    """After the console closed: 0, or every internal error's traceback on stderr and :attr:`Exit.FAILED`."""
+def closed(app: SafeApp, command: str, log: LogFile | None = None) -> int:
+    """After the console closed: 0, or every internal error's traceback on stderr (and in the log file) and
+    :attr:`Exit.FAILED`."""
     if app.incidents:
-        print(app.incidents.report(command), file=sys.stderr)
+        report = app.incidents.report(command)
+        print(report, file=sys.stderr)
+        if log is not None:
+            log.write(report)
         return int(Exit.FAILED)
     if app.return_code:
         return refuse(command, f"the console stopped with status {app.return_code}", Exit.FAILED)

@@ -1,5 +1,6 @@
 """The unexpected errors of a console session (see :mod:`tui.guard` for how they are caught): shown in the alarm panel
-at once, and every traceback printed on stderr when the console closes, with exit status 1.
+at once, written to the log file (``--log``, :mod:`tui.logfile`) as they happen, and every traceback printed on stderr
+when the console closes, with exit status 1.
 """
 
 from __future__ import annotations
@@ -8,6 +9,7 @@ import traceback
 from dataclasses import dataclass
 
 from liansuo.kit.printable import printable, printable_block
+from liansuo.tui.logfile import LOGGER
 from liansuo.tui.panels import AlarmLine
 
 # How many different incidents a session keeps (the same error again only counts up): enough for any report, and a
@@ -54,8 +56,11 @@ class Incidents:
             if known.where == where and known.trace == trace:
                 known.count += 1
                 known.acknowledged = False
+                if known.count in (2, 10, 100, 1000, 10000):  # a handler failing on every redraw fills no disk
+                    LOGGER.error("console error in %s again (%d times)", where, known.count)
                 return known
         incident = Incident(where, t, error, trace)
+        LOGGER.error("console error%s in %s:\n%s", "" if t is None else f" at t={t:g} s", where, trace.rstrip("\n"))
         if len(self.items) < MAX_INCIDENTS:
             self.items.append(incident)
         else:

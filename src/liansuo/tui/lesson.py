@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING, Any
 
 from rich.text import Text
 
-from liansuo.classroom.exercise import Exercise, GoalCheck, bundled_exercises, check_goal, parse_exercise
+from liansuo.classroom.exercise import Exercise, GoalCheck, bundled_exercises, check_goal, exercises_for, parse_exercise
 from liansuo.classroom.passwords import matches
 from liansuo.kit.printable import printable
 from liansuo.kit.source import StationError
@@ -50,7 +50,8 @@ class LessonControls:
         def push_screen(self, screen: Any, callback: Any = None) -> Any: ...
 
     def _exercise_files(self) -> list[Path]:
-        files = bundled_exercises()
+        """The panel's exercises: the bundled ones for this console's station, and the one it was started with."""
+        files = exercises_for(self.sim.station.id, bundled_exercises())
         if self._exercise_arg is not None and Path(self._exercise_arg) not in files:
             files.append(Path(self._exercise_arg))
         return files

@@ -146,13 +146,26 @@ class EventLog(Guarded, RichLog):
         super().__init__(id=id, max_lines=2000, wrap=False, markup=False, highlight=False)
         self.border_title = "事件 Events"
         self.lines_text: list[str] = []
+        self.line_styles: list[str] = []  # each line's style, beside lines_text
 
     def add(self, text: str, style: str = "") -> None:
         text = printable(text)
         self.lines_text.append(text)
+        self.line_styles.append(style)
         if len(self.lines_text) > 4000:
-            del self.lines_text[:2000]
+            del self.lines_text[:2000], self.line_styles[:2000]
         self.write(Text(text, style=style))
+
+    def entries(self) -> list[tuple[str, str]]:
+        """Every line kept, with its style: what :meth:`show` writes back."""
+        return list(zip(self.lines_text, self.line_styles, strict=True))
+
+    def show(self, entries: list[tuple[str, str]]) -> None:
+        """These lines instead of those shown (the instructor's console shows each seat's own log)."""
+        self.clear()
+        self.lines_text, self.line_styles = [], []
+        for text, style in entries[-self.max_lines if self.max_lines else 0:]:
+            self.add(text, style)
 
 
 class EventReader:

@@ -83,8 +83,7 @@ class ReplayApp(ConsoleApp):
             self.sim = self.replayer.sim
             self.operator.sim = self.sim
             self.events.reset()
-            self.log_panel.clear()
-            self.log_panel.lines_text.clear()
+            self.log_panel.show([])
             before = 0
         self._log_played(before)
         self.diagram.update_view()
