@@ -20,7 +20,7 @@ from rich.text import Text
 from textual.actions import SkipAction
 from textual.app import ComposeResult
 from textual.binding import BindingType
-from textual.containers import Horizontal, Vertical
+from textual.containers import Horizontal
 from textual.widgets import Footer, Input
 
 from liansuo.classroom.exercise import Exercise, GoalCheck
@@ -34,7 +34,7 @@ from liansuo.simulation.sim import Simulation
 from liansuo.tui.completion import example_route
 from liansuo.tui.consolesim import ConsoleSim
 from liansuo.tui.describe import describe
-from liansuo.tui.diagram import Diagram
+from liansuo.tui.diagram import Diagram, DiagramColumn
 from liansuo.tui.dialogs import ConfirmScreen, HelpScreen, MenuScreen
 from liansuo.tui.fieldmode import FieldModeControls
 from liansuo.tui.grid import Ref
@@ -86,7 +86,7 @@ class ConsoleApp(SafeApp, LessonControls, FieldModeControls):
     ConsoleScreen { layout: vertical; background: #0c0f12; }  /* only the console's own: dialogs let it show */
     #main { height: 1fr; }
     #left { width: 1fr; }
-    Diagram { height: 3fr; }
+    Diagram { height: 3fr; }  /* until the column shares its lines (tui/diagram.py, DiagramColumn) */
     #panels { height: 1fr; min-height: 4; }
     AlarmPanel { width: 2fr; }
     EventLog { width: 3fr; }
@@ -138,7 +138,7 @@ class ConsoleApp(SafeApp, LessonControls, FieldModeControls):
     # ---- layout ----
     def compose(self) -> ComposeResult:
         yield StatusBar(id="status")
-        with Horizontal(id="main"), Vertical(id="left"):
+        with Horizontal(id="main"), DiagramColumn(id="left"):
             yield Diagram(lambda: self.sim, self.operator.pressed, id="diagram", operable=self.operator.operable)
             with Horizontal(id="panels"):
                 yield AlarmPanel(id="alarms")

@@ -15,6 +15,8 @@ from rich.segment import Segment
 from rich.style import Style
 from textual import events
 from textual.binding import Binding, BindingType
+from textual.containers import Vertical
+from textual.css.scalar import Scalar, Unit
 from textual.geometry import Region, Size
 from textual.message import Message
 from textual.scroll_view import ScrollView
@@ -29,6 +31,26 @@ if TYPE_CHECKING:
     from liansuo.tui.consolesim import ConsoleSim
 
 CLICKABLE = ("button", "turnout", "signal", "section", "platform", "block")
+LINES_PER_ROW = (8, 7, 6, 5, 4, 3)  # the schematic rows' spacing, widest first
+MIN_PANELS = 5  # lines the alarm and event panels keep however small the window
+PANELS_SHARE = 3  # ... and a third of a column that has the room: the rest is the diagram's
+
+
+def lines_per_row(column: int, height: Callable[[int], int]) -> int:
+    """The widest spacing of the schematic rows whose drawing (``height(lpr)`` lines, a line more for a scroll bar)
+    leaves the panels under it a third of the ``column`` and at least :data:`MIN_PANELS` lines; the narrowest when
+    none does (the diagram then takes all but :data:`MIN_PANELS` lines and scrolls)."""
+    room = column - max(MIN_PANELS, column // PANELS_SHARE)
+    return next((n for n in LINES_PER_ROW if height(n) + 1 <= room), LINES_PER_ROW[-1])
+
+
+class DiagramColumn(Guarded, Vertical):
+    """The diagram over the alarm and event panels: on every change of its size it tells the diagram how many lines
+    they share (:meth:`Diagram.share`)."""
+
+    def on_resize(self, event: events.Resize) -> None:
+        for diagram in self.query(Diagram):
+            diagram.share(self.size.height)
 
 
 class Diagram(Guarded, ScrollView, can_focus=True):
@@ -73,7 +95,8 @@ class Diagram(Guarded, ScrollView, can_focus=True):
         self._pressed = pressed
         self._operable = operable  # where the keyboard cursor may stop now (a route started: only buttons)
         self.zoom: int | None = None  # None: fit the window
-        self.lpr: int | None = None
+        self.lpr: int | None = None  # lines per schematic row; None: chosen for the window
+        self.column: int | None = None  # the lines of the column shared with the panels (:meth:`share`)
         self.layout_: Layout | None = None
         self._layouts: dict[tuple[int, int, int], Layout] = {}
         self._frame: Frame | None = None
@@ -93,16 +116,21 @@ class Diagram(Guarded, ScrollView, can_focus=True):
             self._layouts[key] = build_layout(self.sim.station, self.sim.rules.lamps, lpr=lpr, zoom=zoom, width=width)
         return self._layouts[key]
 
+    def share(self, column: int) -> None:
+        """The diagram stands over the panels in a column of ``column`` lines: it takes the lines its drawing needs
+        (:func:`lines_per_row`), the panels the rest."""
+        if column != self.column:
+            self.column = column
+            self.relayout()
+
     def relayout(self) -> None:
         w, h = max(20, self.size.width), max(6, self.size.height)
-        if self.lpr is None:
-            lpr = 3
-            for cand in (6, 5, 4):
-                if self._build(cand, 0, 0).height <= h - 1:
-                    lpr = cand
-                    break
-        else:
+        if self.lpr is not None:
             lpr = self.lpr
+        elif self.column is not None:
+            lpr = lines_per_row(self.column, lambda n: self._build(n, 0, 0).height)
+        else:
+            lpr = next((n for n in (6, 5, 4) if self._build(n, 0, 0).height <= h - 1), 3)
         if self.zoom is None:
             zoom = next((z for z in range(MAX_ZOOM, -1, -1) if self._build(lpr, z, 0).width <= w), 1)
             lay = self._build(lpr, zoom, w if self._build(lpr, zoom, 0).width <= w else 0)
@@ -110,6 +138,12 @@ class Diagram(Guarded, ScrollView, can_focus=True):
             lay = self._build(lpr, self.zoom, 0)
         self.layout_ = lay
         self.virtual_size = Size(lay.width, lay.height)
+        if self.column is not None:
+            # the drawing's lines, a line for the scroll bar when it is wider than the window; the panels keep theirs
+            lines = lay.height + (1 if lay.width > self.size.width else 0)
+            lines = max(3, min(lines, self.column - MIN_PANELS))
+            if self.styles.height != Scalar(lines, Unit.CELLS, Unit.WIDTH):
+                self.styles.height = lines
         if not self._centred and self.size.width > 0:
             self._centred = True
             self.call_after_refresh(self._centre)
