@@ -319,7 +319,9 @@ class Diagram(Guarded, ScrollView, can_focus=True):
             middle = (sx + self.size.width / 2, sy + self.size.height / 2)
             self.cursor = min(centres, key=lambda r: distance(centres[r], middle))
         else:
-            self.cursor = nearest(centres, self.cursor, (dx, dy)) or self.cursor
+            lines = track_lines(lay)
+            rows = {ref: row_of(y, lines) for ref, (_, y) in centres.items()}
+            self.cursor = nearest(centres, self.cursor, (dx, dy), rows) or self.cursor
         self.offset_of(self.cursor)
         self.refresh()
         self.post_message(self.CursorMoved(self.cursor))
@@ -358,19 +360,24 @@ KEYBOARD = ("button", "turnout", "signal", "section")  # what the arrow keys sto
 ROW_CELLS = 2.0  # a terminal cell is about twice as tall as it is wide: a line counts as two columns
 OFF_AXIS = 2.0  # a step sideways costs as much as two steps along the arrow
 CONE = 0.5  # within about 27 degrees of the arrow: sideways at most half as far as along it
-OUTSIDE_CONE = 1000.0  # an element outside the cone is taken only when none lies within
+WIDE_CONE = 3.0  # then within about 72 degrees; one nearly square to the arrow never
+OUTSIDE_CONE = 1000.0  # an element outside the narrow cone is taken only when none lies within
 
 
 def distance(a: tuple[float, float], b: tuple[float, float]) -> float:
     return abs(a[0] - b[0]) + ROW_CELLS * abs(a[1] - b[1])
 
 
-def nearest(centres: dict[Ref, tuple[float, float]], start: Ref, direction: tuple[int, int]) -> Ref | None:
+def nearest(centres: dict[Ref, tuple[float, float]], start: Ref, direction: tuple[int, int],
+            rows: dict[Ref, int] | None = None) -> Ref | None:
     """The element an arrow goes to from ``start``: among those ahead in ``direction`` (a unit step, (1, 0) right,
-    (0, 1) down), the one with the least distance along the arrow plus twice the distance across it, preferring
-    those within :data:`CONE` of it; None when nothing lies ahead."""
+    (0, 1) down), the one with the least distance along the arrow plus twice the distance across it. Left and right
+    first keep to the track ``start`` belongs to (its row in ``rows``: the track's line, for a label the track it is
+    written beside), within 45 degrees of the arrow; then come those within :data:`CONE` of the arrow, then those
+    within :data:`WIDE_CONE`. None when nothing lies that way (the cursor stays)."""
     x0, y0 = centres[start]
     ux, uy = direction
+    row = rows.get(start) if rows is not None and uy == 0 else None
     best: tuple[float, Ref] | None = None
     for ref, (x, y) in centres.items():
         dx, dy = x - x0, ROW_CELLS * (y - y0)
@@ -378,7 +385,26 @@ def nearest(centres: dict[Ref, tuple[float, float]], start: Ref, direction: tupl
         if ref == start or along <= 0:
             continue
         across = abs(dx * uy) + abs(dy * ux)
-        score = along + OFF_AXIS * across + (OUTSIDE_CONE if across > CONE * along else 0.0)
+        if row is not None and rows is not None and rows.get(ref) == row and across <= along:
+            tier = 0.0
+        elif across <= CONE * along:
+            tier = OUTSIDE_CONE
+        elif across <= WIDE_CONE * along:
+            tier = 2 * OUTSIDE_CONE
+        else:
+            continue  # nearly square to the arrow: not where it points
+        score = tier + along + OFF_AXIS * across
         if best is None or score < best[0]:
             best = (score, ref)
     return best[1] if best is not None else None
+
+
+def track_lines(lay: Layout) -> list[int]:
+    """The lines a track is drawn along (its band), top to bottom."""
+    return [y for y, line in enumerate(lay.grid) if any(g is not None and g.role == "band" for g in line)]
+
+
+def row_of(y: float, lines: list[int]) -> int:
+    """The track line nearest the line ``y``: a label's is the track it is written beside (on a tie, the one
+    below)."""
+    return min(lines, key=lambda line: (abs(line - y), line < y)) if lines else round(y)
