@@ -301,14 +301,18 @@ class ConsoleApp(SafeApp, LessonControls, FieldModeControls):
             out.append(f"│ ⚠ {alarms} alarm{'s' if alarms > 1 else ''} ", style="bold #ff4040")
         if self.alarm_bell.muted:
             out.append("│ 🔕 bell muted (m) ", style="#ffd700")
-        if self._waiting:
-            out.append(f"│ {self._waiting} ", style="#ff8080")
         counting = self.diagram.frame().countdown if self.diagram.layout_ is not None else {}
         if counting:
             out.append("│ 人解 " + " ".join(f"{s} {n}s" for s, n in sorted(counting.items())) + " ", style="#ffd700")
         self.control_status(out)
         self.lesson_status(out)
+        self.more_status(out)
+        if self._waiting:  # last: the longest, and said whole on the answer line too, so a narrow window cuts it
+            out.append(f"│ {self._waiting} ", style="#ff8080")
         return out
+
+    def more_status(self, out: Text) -> None:
+        """What a console adds to the status line before why a signal waits (a classroom's seat and its link)."""
 
     # ---- commands ----
     def send(self, line: str, source: str = "trainee") -> Result:
@@ -512,4 +516,16 @@ class ConsoleApp(SafeApp, LessonControls, FieldModeControls):
 
     def action_help(self) -> None:
         self.push_screen(HelpScreen(example_route(self.sim)))
+
+    # ---- which keys are this operator's ----
+    def check_action(self, action: str, parameters: tuple[object, ...]) -> bool | None:
+        """The footer shows, and the keys run, only what this operator may do now (Textual asks this of every
+        binding): the briefing while an exercise is on, and what :meth:`allowed` lets through."""
+        if action == "briefing":
+            return self.briefing() is not None
+        return self.allowed(action)
+
+    def allowed(self, action: str) -> bool:
+        """Whether the operator at this console may run ``action`` (a local console's operator may run all)."""
+        return True
 
