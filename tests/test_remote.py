@@ -27,6 +27,7 @@ from liansuo.server.classroom import Classroom
 from liansuo.server.client import ClassroomClient
 from liansuo.server.websocket import ClassroomServer
 from liansuo.tui.briefing import BriefingScreen
+from liansuo.tui.commands import console_commands
 from liansuo.tui.grid import Ref
 from liansuo.tui.paint import BAND_COLOUR, glyph
 
@@ -138,6 +139,8 @@ async def test_a_trainees_instructor_command_is_refused_with_the_reason(server: 
         await pilot.press("escape")  # from the command bar back to the diagram
         keys = footer(app)  # the trainee's own keys: no clock, no F2 and no F3 (issue 46, item 5)
         assert "? help" in keys and "space" not in keys and "F2" not in keys and "F3" not in keys, keys
+        titles = [c.title for c in console_commands(app)]  # nor in the command palette (item 7)
+        assert "route X XI" in titles and "pause / run" not in titles and "instructor panel" not in titles, titles
         await pilot.press("f2")
         assert "instructor's console" in message(app) and app.instructor_panel is None, message(app)
         await pilot.press("space")

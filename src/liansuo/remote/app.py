@@ -26,7 +26,6 @@ from liansuo.remote.login import LoginScreen
 from liansuo.remote.sim import ENDED, LOST, NOT_IN, RemoteSimulation
 from liansuo.tui.app import SPEEDS, ConsoleApp
 from liansuo.tui.briefing import Briefing
-from liansuo.tui.instructor import InstructorPanel
 
 
 class RemoteConsoleApp(ConsoleApp):
@@ -219,8 +218,9 @@ class RemoteConsoleApp(ConsoleApp):
         self.refresh_views()
         self.say(f"seat {event.seat}: every command goes to this seat; F3 the seats", True)
 
-    def on_instructor_panel_load_exercise(self, event: InstructorPanel.LoadExercise) -> None:
-        name = Path(event.path).stem
+    def load_chosen_exercise(self, path: str) -> None:
+        """The server starts it on the seat, with the difficulty and the seed the instructor picks."""
+        name = Path(path).stem
         self.push_screen(ExercisePicker([name], f"seat {self.seat}"), self._exercise_chosen)
 
     def _exercise_chosen(self, choice: ExerciseChoice | None) -> None:

@@ -31,6 +31,7 @@ from liansuo.simulation import Result
 from liansuo.simulation.fieldlink import FieldLink
 from liansuo.simulation.recording.recorder import FileRecorder
 from liansuo.simulation.sim import Simulation
+from liansuo.tui.commands import ConsoleCommands
 from liansuo.tui.completion import example_route
 from liansuo.tui.consolesim import ConsoleSim
 from liansuo.tui.describe import describe
@@ -93,6 +94,7 @@ class ConsoleApp(SafeApp, LessonControls, FieldModeControls):
     """
 
     BINDINGS: ClassVar[list[BindingType]] = CONSOLE_BINDINGS
+    COMMANDS = SafeApp.COMMANDS | {ConsoleCommands}  # the console's own actions in the palette (tui/commands.py)
 
     def __init__(self, station: str = "jiaopei", *, paused: bool = False, speed: float = 1.0,
                  instructor_password: str | None = None, instructor_hash: str | None = None,

@@ -51,6 +51,10 @@ class LessonControls:
         def push_screen(self, screen: Any, callback: Any = None) -> Any: ...
         def refresh_bindings(self) -> None: ...
 
+    def exercise_files(self) -> list[Path]:
+        """The exercises the instructor may load: the bundled ones, and the one the console was started with."""
+        return self._exercise_files()
+
     def _exercise_files(self) -> list[Path]:
         files = bundled_exercises()
         if self._exercise_arg is not None and Path(self._exercise_arg) not in files:
@@ -95,7 +99,11 @@ class LessonControls:
         self.send(event.line, "instructor")
 
     def on_instructor_panel_load_exercise(self, event: InstructorPanel.LoadExercise) -> None:
-        self.load_exercise(event.path)
+        self.load_chosen_exercise(event.path)
+
+    def load_chosen_exercise(self, path: str) -> None:
+        """The instructor chose an exercise (the panel's Load, the palette): this console loads it."""
+        self.load_exercise(path)
 
     def load_exercise(self, path: str) -> None:
         self.stop_run()
