@@ -31,7 +31,7 @@ from liansuo.simulation import Result
 from liansuo.simulation.fieldlink import FieldLink
 from liansuo.simulation.recording.recorder import FileRecorder
 from liansuo.simulation.sim import Simulation
-from liansuo.tui.commands import ConsoleCommands
+from liansuo.tui.commands import ConsoleCommands, PaletteCommand, console_commands
 from liansuo.tui.completion import example_route
 from liansuo.tui.consolesim import ConsoleSim
 from liansuo.tui.describe import describe
@@ -530,4 +530,8 @@ class ConsoleApp(SafeApp, LessonControls, FieldModeControls):
     def allowed(self, action: str) -> bool:
         """Whether the operator at this console may run ``action`` (a local console's operator may run all)."""
         return True
+
+    def palette_commands(self) -> list[PaletteCommand]:
+        """The console's actions in the command palette now (tui/commands.py)."""
+        return console_commands(self)
 

@@ -18,15 +18,15 @@ from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from functools import partial
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any, Protocol
 
 from textual.command import DiscoveryHit, Hit, Hits, Provider
 
 from liansuo.kit.printable import printable
+from liansuo.simulation import Result
+from liansuo.tui.consolesim import ConsoleSim
+from liansuo.tui.diagram import Diagram
 from liansuo.tui.operate import MODES
-
-if TYPE_CHECKING:
-    from liansuo.tui.app import ConsoleApp
 
 
 @dataclass(frozen=True)
@@ -36,20 +36,44 @@ class PaletteCommand:
     run: Callable[[], Any]
 
 
-def console_commands(app: ConsoleApp) -> list[PaletteCommand]:
+class Console(Protocol):
+    """What the palette asks of the console (:class:`~tui.app.ConsoleApp`, which hands its commands to the
+    provider through ``palette_commands``)."""
+
+    sim: ConsoleSim
+    diagram: Diagram
+    instructor: bool
+
+    def submit_line(self, line: str) -> None: ...
+    def send(self, line: str, source: str = "trainee") -> Result: ...
+    def check_action(self, action: str, parameters: tuple[object, ...]) -> bool | None: ...
+    def allowed(self, action: str) -> bool: ...
+    def action_arm(self, mode: str) -> None: ...
+    def action_help(self) -> None: ...
+    def action_briefing(self) -> None: ...
+    def action_acknowledge(self) -> None: ...
+    def action_mute(self) -> None: ...
+    def action_pause(self) -> None: ...
+    def action_speed(self, step: int) -> None: ...
+    async def action_instructor(self) -> None: ...
+    def exercise_files(self) -> list[Path]: ...
+    def load_chosen_exercise(self, path: str) -> None: ...
+
+
+def console_commands(app: Console) -> list[PaletteCommand]:
     """What the palette offers on ``app`` now, in this order: the routes set (to cancel), the table's routes, the
     function buttons, the view, the exercise, the clock and the alarms, the instructor's."""
     return [*_cancels(app), *_routes(app), *_functions(app), *_view(app), *_instructor(app)]
 
 
-def _cancels(app: ConsoleApp) -> Iterator[PaletteCommand]:
+def _cancels(app: Console) -> Iterator[PaletteCommand]:
     for r in app.sim.view.routes():
         line = f"cancel {r.signal}"
         yield PaletteCommand(printable(line), f"总取消: cancel route {printable(r.id)} ({r.state})",
                              partial(app.submit_line, line))
 
 
-def _routes(app: ConsoleApp) -> Iterator[PaletteCommand]:
+def _routes(app: Console) -> Iterator[PaletteCommand]:
     for r in app.sim.table.routes.values():
         word = "route" if r.kind == "train" else "shunt"
         line = " ".join([word, r.start, *r.via, r.end])
@@ -58,14 +82,14 @@ def _routes(app: ConsoleApp) -> Iterator[PaletteCommand]:
                              partial(app.submit_line, line))
 
 
-def _functions(app: ConsoleApp) -> Iterator[PaletteCommand]:
+def _functions(app: Console) -> Iterator[PaletteCommand]:
     for m in MODES.values():
         then = f"then the {m.target}" if m.target != "station" else "asks at once"
         yield PaletteCommand(f"{m.zh} {m.en}", f"function button (key {m.key}): {then}",
                              partial(app.action_arm, m.name))
 
 
-def _view(app: ConsoleApp) -> Iterator[PaletteCommand]:
+def _view(app: Console) -> Iterator[PaletteCommand]:
     d = app.diagram
     yield PaletteCommand("zoom in", "the diagram wider (key +)", partial(d.action_zoom, 1))
     yield PaletteCommand("zoom out", "the diagram narrower (key -)", partial(d.action_zoom, -1))
@@ -81,12 +105,13 @@ def _view(app: ConsoleApp) -> Iterator[PaletteCommand]:
         yield PaletteCommand("slower", "the clock's speed (key <)", partial(app.action_speed, -1))
 
 
-def _instructor(app: ConsoleApp) -> Iterator[PaletteCommand]:
+def _instructor(app: Console) -> Iterator[PaletteCommand]:
     if not app.allowed("instructor"):
         return
     yield PaletteCommand("instructor panel", "faults, field, trains and exercises (F2)", app.action_instructor)
-    if app.allowed("dashboard") and hasattr(app, "action_dashboard"):
-        yield PaletteCommand("seats", "the classroom's dashboard of seats (F3)", app.action_dashboard)
+    dashboard = getattr(app, "action_dashboard", None)  # a classroom's console has the seats
+    if dashboard is not None and app.allowed("dashboard"):
+        yield PaletteCommand("seats", "the classroom's dashboard of seats (F3)", dashboard)
     if not app.instructor:
         return
     for fault in app.sim.field.faults.values():
@@ -102,10 +127,8 @@ class ConsoleCommands(Provider):
     """The console's commands for Textual's command palette."""
 
     def _commands(self) -> list[PaletteCommand]:
-        from liansuo.tui.app import ConsoleApp
-
-        app = self.app
-        return console_commands(app) if isinstance(app, ConsoleApp) else []
+        commands: Callable[[], list[PaletteCommand]] | None = getattr(self.app, "palette_commands", None)
+        return commands() if commands is not None else []
 
     async def discover(self) -> Hits:
         for c in self._commands():
