@@ -57,6 +57,8 @@ def shoot(ws: str, web: str, out: Path) -> None:
                 teacher.request({"type": "exercise", "seats": [1], "name": "jiaopei-cancel-route", "seed": 1})
             time.sleep(3)
             li.focus(TEXTAREA)
+            li.press("Escape")  # the exercise's briefing, shown when it starts, read and closed
+            time.sleep(1)
             li.type(":cancel X")
             li.press("Enter")
             time.sleep(2)

@@ -15,7 +15,8 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from consoletest import SIZE, message, run
+from consoletest import SIZE, footer, message, run
+from textual.widgets import Static
 
 from liansuo.classroom.passwords import hash_password
 from liansuo.remote.app import RemoteConsoleApp
@@ -25,6 +26,8 @@ from liansuo.remote.sim import ENDED, LOST
 from liansuo.server.classroom import Classroom
 from liansuo.server.client import ClassroomClient
 from liansuo.server.websocket import ClassroomServer
+from liansuo.tui.briefing import BriefingScreen
+from liansuo.tui.commands import console_commands
 from liansuo.tui.grid import Ref
 from liansuo.tui.paint import BAND_COLOUR, glyph
 
@@ -133,10 +136,17 @@ async def test_a_trainees_instructor_command_is_refused_with_the_reason(server: 
         assert "refused" in log(app)
         assert server.classroom.seat(1).sim.field.faults == {}  # nothing reached the server's simulation
         assert server.classroom.seat(1).refused == 1  # the server judged it, and counts it for the instructor
-        await pilot.press("escape", "f2")  # from the command bar back to the diagram
+        await pilot.press("escape")  # from the command bar back to the diagram
+        keys = footer(app)  # the trainee's own keys: no clock, no F2 and no F3 (issue 46, item 5)
+        assert "? help" in keys and "space" not in keys and "F2" not in keys and "F3" not in keys, keys
+        titles = [c.title for c in console_commands(app)]  # nor in the command palette (item 7)
+        assert "route X XI" in titles and "pause / run" not in titles and "instructor panel" not in titles, titles
+        await pilot.press("f2")
         assert "instructor's console" in message(app) and app.instructor_panel is None, message(app)
         await pilot.press("space")
         assert "the instructor pauses and runs it" in message(app), message(app)
+        await pilot.press("f3")
+        assert "dashboard is the instructor's" in message(app) and app.screen is app.screen_stack[0], message(app)
         assert not server.classroom.seat(1).desk.paused
 
 
@@ -403,6 +413,10 @@ async def test_a_trainee_reads_the_exercise_started_on_the_seat_and_its_score_at
         await until(pilot, lambda: "Cancel a wrong route" in str(app.status_bar.content))
         assert "0/2 goals" in str(app.status_bar.content) and "left" in str(app.status_bar.content)
         assert "dispatcher wants the train on the main track IG" in log(app)  # the briefing, in the event log
+        await until(pilot, lambda: isinstance(app.screen, BriefingScreen))  # and in a dialog of its own
+        text = str(app.screen.query_one("#briefing", Static).content)
+        assert "dispatcher wants the train on the main track IG" in text and "· " in text, text
+        await pilot.press("escape")
         await until(pilot, lambda: band(app, "3G") == BAND_COLOUR["locked"])  # the setup's route X-X3
         await type_line(pilot, "cancel X")
         await until(pilot, lambda: band(app, "3G") == BAND_COLOUR["free"])

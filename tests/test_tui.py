@@ -11,6 +11,7 @@ import pytest
 from consoletest import SIZE, message, run
 
 from liansuo.tui.app import ConsoleApp
+from liansuo.tui.briefing import BriefingScreen
 from liansuo.tui.diagram import Diagram
 from liansuo.tui.dialogs import ConfirmScreen, MenuScreen, PasswordScreen
 from liansuo.tui.grid import Ref
@@ -283,6 +284,9 @@ async def test_an_exercise_loads_its_faults_and_notices_the_goal() -> None:
     async with app.run_test(size=SIZE) as pilot:
         assert app.exercise is not None and ("no-indication", "5") in app.sim.field.faults
         assert app.goal is not None and not app.goal.reached
+        await pilot.pause()
+        assert isinstance(app.screen, BriefingScreen)  # the briefing first: the trainee closes it to operate
+        await pilot.press("escape")
         await pilot.press("l")
         await click(pilot, Ref("turnout", "5"))
         await click(pilot, Ref("button", "X", "train"))
@@ -416,6 +420,7 @@ async def test_the_trainees_command_bar_refuses_the_instructors_commands_and_hid
     app = ConsoleApp("jiaopei", paused=True, exercise="jiaopei-broken-rail-IG")
     async with app.run_test(size=SIZE) as pilot:
         await pilot.pause()
+        await pilot.press("escape")  # the briefing
         assert app.sim.section_state("IG") == "occupied"  # the exercise's broken rail is in
         for line in ("faults", "repair broken-rail IG", "fault filament X", "train T1 at IAG", "occupy 3G"):
             await pilot.press("colon", *line, "enter")

@@ -5,10 +5,7 @@ muted), and hints use the station's own ids. Driven through Textual's Pilot; wha
 
 from __future__ import annotations
 
-import io
-
-from consoletest import SIZE, message, run
-from rich.console import Console
+from consoletest import SIZE, message, run, screen_lines
 from textual import events
 from textual.geometry import Region
 from textual.widgets import Static
@@ -26,16 +23,6 @@ def burst_of_keys(app: ConsoleApp, keys: list[str]) -> None:
     for key in keys:
         char = {"colon": ":", "space": " "}.get(key, key)
         app.post_message(events.Key(key, char))
-
-
-def screen_lines(app: ConsoleApp) -> list[str]:
-    """The screen as the terminal shows it, dialogs over the screens below them (as App.export_screenshot renders
-    it), one string per line."""
-    width, height = app.size
-    console = Console(width=width, height=height, file=io.StringIO(), record=True, color_system=None,
-                      legacy_windows=False)
-    console.print(app.screen._compositor.render_update(full=True, screen_stack=app._background_screens))
-    return console.export_text().split("\n")[:height]
 
 
 def outside(lines: list[str], area: Region, box: Region) -> list[str]:

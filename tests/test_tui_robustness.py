@@ -13,6 +13,7 @@ from consoletest import SIZE, message, run
 from textual import events
 from textual.app import App
 from textual.command import CommandPalette
+from textual.widgets import Static
 
 from liansuo.cli.main import main
 from liansuo.stations.loader import load
@@ -267,6 +268,10 @@ async def test_escape_sequences_and_markup_from_a_file_are_shown_as_written(tmp_
         assert "[bold red]x[/] [/y]" in status  # shown as written, not as markup
         assert "\\x1b[2J" in message(app) and "\x1b" not in message(app)
         app.load_exercise(str(exercise))
+        await pilot.pause()
+        shown = str(app.screen.query_one("#briefing", Static).content)  # the briefing: markup shown as written
+        assert "[/x] a lesson" in shown and "[bold]d" in shown and "[/goal] \\x" in shown, shown
+        await pilot.press("escape")
         await pilot.press("f2")  # the instructor's panel shows the goal: '[/goal]' was a MarkupError before
         await pilot.pause()
         assert app.instructor_panel is not None

@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import Any, ClassVar
 
 from rich.text import Text
+from textual import events
 from textual.binding import Binding, BindingType
 
 from liansuo.classroom.roles import INSTRUCTOR
@@ -25,13 +26,26 @@ from liansuo.remote.link import ServerLink, Unlinked
 from liansuo.remote.login import LoginScreen
 from liansuo.remote.sim import ENDED, LOST, NOT_IN, RemoteSimulation
 from liansuo.tui.app import SPEEDS, ConsoleApp
-from liansuo.tui.instructor import InstructorPanel
+from liansuo.tui.briefing import Briefing
 from liansuo.tui.panels import EventReader
 
 
 class RemoteConsoleApp(ConsoleApp):
     LOCAL_CLOCK = False
     LOCAL_ROLES = False
+    # the keys a trainee's seat leaves out of its footer and refuses: the classroom's clock, the instructor's panel
+    # and the seats' dashboard are the instructor's
+    INSTRUCTORS_KEYS = frozenset({"pause", "step", "speed", "instructor", "dashboard"})
+    # ... but said why when pressed there
+    REFUSED_KEYS: ClassVar[dict[str, str]] = {
+        "space": "the clock is the classroom's: the instructor pauses and runs it",
+        "full_stop": "the clock is the classroom's: the instructor pauses and runs it",
+        "greater_than_sign": "the clock is the classroom's: the instructor sets its speed",
+        "less_than_sign": "the clock is the classroom's: the instructor sets its speed",
+        "f2": "F2, the instructor's panel, is on the instructor's console: a trainee's seat operates the station "
+              "with the console's buttons",
+        "f3": "the seats' dashboard is the instructor's",
+    }
     BINDINGS: ClassVar[list[BindingType]] = [
         *ConsoleApp.BINDINGS,
         Binding("f3", "dashboard", "seats", key_display="F3"),
@@ -78,6 +92,7 @@ class RemoteConsoleApp(ConsoleApp):
         self._generation, self._was_live, self._ended = link.generation, True, False
         self.remote.step()
         self.refresh_views()
+        self.refresh_bindings()  # the footer: this role's keys
         self.greet()
 
     def greet(self) -> None:
@@ -116,20 +131,41 @@ class RemoteConsoleApp(ConsoleApp):
             incident = self.report_unexpected(exc, "the classroom link")
             self.say(f"internal error: {incident.summary} (see the alarms)", False)
 
+    def allowed(self, action: str) -> bool:
+        return self.instructor or action not in self.INSTRUCTORS_KEYS
+
+    def on_key(self, event: events.Key) -> None:
+        """An instructor's key pressed at a trainee's seat: not in the footer and not run, but said why."""
+        if not self.instructor and event.key in self.REFUSED_KEYS:
+            self.say(self.REFUSED_KEYS[event.key], False)
+
+    def briefing(self) -> Briefing | None:
+        """The seat's exercise as the server tells it: the briefing, each goal met or not, the time left or the
+        score."""
+        lesson = self.remote.lesson
+        if lesson is None:
+            return None
+        goals = [(str(g["description"]), bool(g["met"])) for g in lesson["goals"]]
+        return Briefing(str(lesson["title"]), str(lesson["briefing"]), goals, lesson_text(lesson))
+
     def follow_lesson(self) -> None:
-        """An exercise started on the seat: its briefing and goals in the log; ended: how, and the score."""
+        """An exercise started on the seat: its briefing and goals in a dialog (a trainee's seat shows it at once;
+        ``e`` shows it again) and in the log; ended: how, and the score."""
         if not self.remote.live:  # the fail-safe picture tells no exercise: the seat's is told as it was
             return
         lesson = self.remote.lesson
         key = None if lesson is None else (lesson["title"], lesson["briefing"])
         if key != self._lesson:
             self._lesson, self._lesson_ended = key, False
+            self.refresh_bindings()  # the footer's 'e briefing'
             if lesson is not None:
                 self.log_panel.add(printable(f"{self.remote.t:9.2f} {'lesson':8} {lesson['title']}: "
                                              f"{' '.join(str(lesson['briefing']).split())}"), "#d0a0ff")
                 for g in lesson["goals"]:
                     self.log_panel.add(printable(f"{'':9} {'goal':8} {g['description']}"), "#d0a0ff")
-                self.say(f"exercise: {lesson['title']} (the briefing is in the event log)", True)
+                self.say(f"exercise: {lesson['title']} (e shows the briefing and the goals again)", True)
+                if not self.instructor:
+                    self.show_briefing()
         if lesson is not None and lesson["finished"] and not self._lesson_ended:
             self._lesson_ended = True
             self.log_panel.add(printable(f"{self.remote.t:9.2f} {'lesson':8} {lesson_text(lesson)}"),
@@ -197,11 +233,11 @@ class RemoteConsoleApp(ConsoleApp):
         """The panel's exercises: those the server may start (its station's), by name."""
         return [Path(n) for n in exercise_names(self.link)] if isinstance(self.link, ServerLink) else []
 
-    def on_instructor_panel_load_exercise(self, event: InstructorPanel.LoadExercise) -> None:
-        """The panel's exercise goes to the server, on this seat (the local console's handler, which loads one into
-        its own simulation, is not for a remote seat: it would refuse it)."""
-        event.prevent_default()
-        name = Path(event.path).stem
+    def load_chosen_exercise(self, path: str) -> None:
+        """The instructor chose an exercise (the panel's Load, the palette): the server starts it on this seat, with
+        the difficulty and the seed the instructor picks (the local console's loading into its own simulation is not
+        for a remote seat)."""
+        name = Path(path).stem
         self.push_screen(ExercisePicker([name], f"seat {self.seat}"), self._exercise_chosen)
 
     def _exercise_chosen(self, choice: ExerciseChoice | None) -> None:
@@ -210,8 +246,7 @@ class RemoteConsoleApp(ConsoleApp):
         reply = self.link.request(choice.message([self.seat]))
         self.say(str(reply.get("message", reply)), reply.get("type") == "ok")
 
-    def status_text(self, alarms: int) -> Text:
-        out = super().status_text(alarms)
+    def more_status(self, out: Text) -> None:
         out.append(f"│ seat {self.seat} ", style="bold")
         lesson = self.remote.lesson
         if lesson is not None:
@@ -221,7 +256,6 @@ class RemoteConsoleApp(ConsoleApp):
             out.append(f"│ {NOT_IN} ", style="bold #ffffff on #c00000")
         elif not self.link.connected:
             out.append(f"│ {ENDED if self.link.ended else LOST} ", style="bold #ffffff on #c00000")
-        return out
 
 
 @dataclass

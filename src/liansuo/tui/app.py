@@ -20,7 +20,7 @@ from rich.text import Text
 from textual.actions import SkipAction
 from textual.app import ComposeResult
 from textual.binding import BindingType
-from textual.containers import Horizontal, Vertical
+from textual.containers import Horizontal
 from textual.widgets import Footer, Input
 
 from liansuo.classroom.exercise import Exercise, GoalCheck
@@ -31,10 +31,11 @@ from liansuo.simulation import Result
 from liansuo.simulation.fieldlink import FieldLink
 from liansuo.simulation.recording.recorder import FileRecorder
 from liansuo.simulation.sim import Simulation
+from liansuo.tui.commands import ConsoleCommands, PaletteCommand, console_commands
 from liansuo.tui.completion import example_route
 from liansuo.tui.consolesim import ConsoleSim
 from liansuo.tui.describe import describe
-from liansuo.tui.diagram import Diagram
+from liansuo.tui.diagram import Diagram, DiagramColumn
 from liansuo.tui.dialogs import ConfirmScreen, HelpScreen, MenuScreen
 from liansuo.tui.fieldmode import FieldModeControls
 from liansuo.tui.grid import Ref
@@ -86,13 +87,14 @@ class ConsoleApp(SafeApp, LessonControls, FieldModeControls):
     ConsoleScreen { layout: vertical; background: #0c0f12; }  /* only the console's own: dialogs let it show */
     #main { height: 1fr; }
     #left { width: 1fr; }
-    Diagram { height: 3fr; }
+    Diagram { height: 3fr; }  /* until the column shares its lines (tui/diagram.py, DiagramColumn) */
     #panels { height: 1fr; min-height: 4; }
     AlarmPanel { width: 2fr; }
     EventLog { width: 3fr; }
     """
 
     BINDINGS: ClassVar[list[BindingType]] = CONSOLE_BINDINGS
+    COMMANDS = SafeApp.COMMANDS | {ConsoleCommands}  # the console's own actions in the palette (tui/commands.py)
 
     def __init__(self, station: str = "jiaopei", *, paused: bool = False, speed: float = 1.0,
                  instructor_password: str | None = None, instructor_hash: str | None = None,
@@ -138,7 +140,7 @@ class ConsoleApp(SafeApp, LessonControls, FieldModeControls):
     # ---- layout ----
     def compose(self) -> ComposeResult:
         yield StatusBar(id="status")
-        with Horizontal(id="main"), Vertical(id="left"):
+        with Horizontal(id="main"), DiagramColumn(id="left"):
             yield Diagram(lambda: self.sim, self.operator.pressed, id="diagram", operable=self.operator.operable)
             with Horizontal(id="panels"):
                 yield AlarmPanel(id="alarms")
@@ -301,14 +303,18 @@ class ConsoleApp(SafeApp, LessonControls, FieldModeControls):
             out.append(f"│ ⚠ {alarms} alarm{'s' if alarms > 1 else ''} ", style="bold #ff4040")
         if self.alarm_bell.muted:
             out.append("│ 🔕 bell muted (m) ", style="#ffd700")
-        if self._waiting:
-            out.append(f"│ {self._waiting} ", style="#ff8080")
         counting = self.diagram.frame().countdown if self.diagram.layout_ is not None else {}
         if counting:
             out.append("│ 人解 " + " ".join(f"{s} {n}s" for s, n in sorted(counting.items())) + " ", style="#ffd700")
         self.control_status(out)
         self.lesson_status(out)
+        self.more_status(out)
+        if self._waiting:  # last: the longest, and said whole on the answer line too, so a narrow window cuts it
+            out.append(f"│ {self._waiting} ", style="#ff8080")
         return out
+
+    def more_status(self, out: Text) -> None:
+        """What a console adds to the status line before why a signal waits (a classroom's seat and its link)."""
 
     # ---- commands ----
     def send(self, line: str, source: str = "trainee") -> Result:
@@ -512,4 +518,20 @@ class ConsoleApp(SafeApp, LessonControls, FieldModeControls):
 
     def action_help(self) -> None:
         self.push_screen(HelpScreen(example_route(self.sim)))
+
+    # ---- which keys are this operator's ----
+    def check_action(self, action: str, parameters: tuple[object, ...]) -> bool | None:
+        """The footer shows, and the keys run, only what this operator may do now (Textual asks this of every
+        binding): the briefing while an exercise is on, and what :meth:`allowed` lets through."""
+        if action == "briefing":
+            return self.briefing() is not None
+        return self.allowed(action)
+
+    def allowed(self, action: str) -> bool:
+        """Whether the operator at this console may run ``action`` (a local console's operator may run all)."""
+        return True
+
+    def palette_commands(self) -> list[PaletteCommand]:
+        """The console's actions in the command palette now (tui/commands.py)."""
+        return console_commands(self)
 

@@ -1,7 +1,9 @@
 """Completion for the command bar, from the simulation's command language: its commands and their usage lines.
 
 The usage line of a command names what each argument is (``SIGNAL``, ``SECTION``, ``TURNOUT``, ``normal|reverse``,
-``[key=value ...]``); the candidates are the station's ids of that kind.
+``[key=value ...]``); the candidates are the station's ids of that kind. A route (``route``, ``shunt``, ``guide``)
+is completed from the interlocking table: the starts of its routes, then the ends (and variant buttons) the table
+has from the start typed.
 """
 
 from __future__ import annotations
@@ -116,6 +118,28 @@ def fault_targets(sim: ConsoleSim, kind_name: str) -> list[str]:
     return []
 
 
+ROUTE_KINDS = {"route": "train", "shunt": "shunt", "guide": "train"}  # commands naming a route by its buttons
+
+
+def route_words(sim: ConsoleSim, kind: str, words: list[str]) -> list[str]:
+    """The next button of a route of the interlocking table after ``words`` (its start, then the variant buttons
+    chosen): the starts of the table's routes of ``kind``; after a start, the ends of its routes from there and their
+    next variant buttons."""
+    routes = [r for r in sim.table.routes.values() if r.kind == kind]
+    if not words:
+        return [r.start for r in routes]
+    start, via = words[0], tuple(words[1:])
+    out = []
+    for r in routes:
+        if r.start != start or tuple(r.via[: len(via)]) != via:
+            continue
+        if len(r.via) == len(via):
+            out.append(r.end)
+        else:
+            out.append(r.via[len(via)])
+    return out
+
+
 def candidates(sim: ConsoleSim, text: str) -> list[str]:
     """Candidates for the last (partial) word of ``text``."""
     words = text.split(" ")
@@ -133,6 +157,8 @@ def candidates(sim: ConsoleSim, text: str) -> list[str]:
                 shape = _EXPECT.get(done[1], ())
                 i = len(done) - 2
                 pool = _ids(sim, shape[i], done) if i < len(shape) else []
+        elif cmd in ROUTE_KINDS and (cmd != "guide" or len(done) > 1):  # guide's SIGNAL: any, by its usage
+            pool = route_words(sim, ROUTE_KINDS[cmd], done[1:])
         else:
             slots = placeholders(language.usage(cmd))
             i = len(done) - 1

@@ -15,6 +15,8 @@ from rich.segment import Segment
 from rich.style import Style
 from textual import events
 from textual.binding import Binding, BindingType
+from textual.containers import Vertical
+from textual.css.scalar import Scalar, Unit
 from textual.geometry import Region, Size
 from textual.message import Message
 from textual.scroll_view import ScrollView
@@ -29,6 +31,26 @@ if TYPE_CHECKING:
     from liansuo.tui.consolesim import ConsoleSim
 
 CLICKABLE = ("button", "turnout", "signal", "section", "platform", "block")
+LINES_PER_ROW = (8, 7, 6, 5, 4, 3)  # the schematic rows' spacing, widest first
+MIN_PANELS = 5  # lines the alarm and event panels keep however small the window
+PANELS_SHARE = 3  # ... and a third of a column that has the room: the rest is the diagram's
+
+
+def lines_per_row(column: int, height: Callable[[int], int]) -> int:
+    """The widest spacing of the schematic rows whose drawing (``height(lpr)`` lines, a line more for a scroll bar)
+    leaves the panels under it a third of the ``column`` and at least :data:`MIN_PANELS` lines; the narrowest when
+    none does (the diagram then takes all but :data:`MIN_PANELS` lines and scrolls)."""
+    room = column - max(MIN_PANELS, column // PANELS_SHARE)
+    return next((n for n in LINES_PER_ROW if height(n) + 1 <= room), LINES_PER_ROW[-1])
+
+
+class DiagramColumn(Guarded, Vertical):
+    """The diagram over the alarm and event panels: on every change of its size it tells the diagram how many lines
+    they share (:meth:`Diagram.share`)."""
+
+    def on_resize(self, event: events.Resize) -> None:
+        for diagram in self.query(Diagram):
+            diagram.share(self.size.height)
 
 
 class Diagram(Guarded, ScrollView, can_focus=True):
@@ -73,7 +95,8 @@ class Diagram(Guarded, ScrollView, can_focus=True):
         self._pressed = pressed
         self._operable = operable  # where the keyboard cursor may stop now (a route started: only buttons)
         self.zoom: int | None = None  # None: fit the window
-        self.lpr: int | None = None
+        self.lpr: int | None = None  # lines per schematic row; None: chosen for the window
+        self.column: int | None = None  # the lines of the column shared with the panels (:meth:`share`)
         self.layout_: Layout | None = None
         self._layouts: dict[tuple[int, int, int], Layout] = {}
         self._frame: Frame | None = None
@@ -93,16 +116,21 @@ class Diagram(Guarded, ScrollView, can_focus=True):
             self._layouts[key] = build_layout(self.sim.station, self.sim.rules.lamps, lpr=lpr, zoom=zoom, width=width)
         return self._layouts[key]
 
+    def share(self, column: int) -> None:
+        """The diagram stands over the panels in a column of ``column`` lines: it takes the lines its drawing needs
+        (:func:`lines_per_row`), the panels the rest."""
+        if column != self.column:
+            self.column = column
+            self.relayout()
+
     def relayout(self) -> None:
         w, h = max(20, self.size.width), max(6, self.size.height)
-        if self.lpr is None:
-            lpr = 3
-            for cand in (6, 5, 4):
-                if self._build(cand, 0, 0).height <= h - 1:
-                    lpr = cand
-                    break
-        else:
+        if self.lpr is not None:
             lpr = self.lpr
+        elif self.column is not None:
+            lpr = lines_per_row(self.column, lambda n: self._build(n, 0, 0).height)
+        else:
+            lpr = next((n for n in (6, 5, 4) if self._build(n, 0, 0).height <= h - 1), 3)
         if self.zoom is None:
             zoom = next((z for z in range(MAX_ZOOM, -1, -1) if self._build(lpr, z, 0).width <= w), 1)
             lay = self._build(lpr, zoom, w if self._build(lpr, zoom, 0).width <= w else 0)
@@ -110,6 +138,12 @@ class Diagram(Guarded, ScrollView, can_focus=True):
             lay = self._build(lpr, self.zoom, 0)
         self.layout_ = lay
         self.virtual_size = Size(lay.width, lay.height)
+        if self.column is not None:
+            # the drawing's lines, a line for the scroll bar when it is wider than the window; the panels keep theirs
+            lines = lay.height + (1 if lay.width > self.size.width else 0)
+            lines = max(3, min(lines, self.column - MIN_PANELS))
+            if self.styles.height != Scalar(lines, Unit.CELLS, Unit.WIDTH):
+                self.styles.height = lines
         if not self._centred and self.size.width > 0:
             self._centred = True
             self.call_after_refresh(self._centre)
@@ -285,7 +319,9 @@ class Diagram(Guarded, ScrollView, can_focus=True):
             middle = (sx + self.size.width / 2, sy + self.size.height / 2)
             self.cursor = min(centres, key=lambda r: distance(centres[r], middle))
         else:
-            self.cursor = nearest(centres, self.cursor, (dx, dy)) or self.cursor
+            lines = track_lines(lay)
+            rows = {ref: row_of(y, lines) for ref, (_, y) in centres.items()}
+            self.cursor = nearest(centres, self.cursor, (dx, dy), rows) or self.cursor
         self.offset_of(self.cursor)
         self.refresh()
         self.post_message(self.CursorMoved(self.cursor))
@@ -324,19 +360,24 @@ KEYBOARD = ("button", "turnout", "signal", "section")  # what the arrow keys sto
 ROW_CELLS = 2.0  # a terminal cell is about twice as tall as it is wide: a line counts as two columns
 OFF_AXIS = 2.0  # a step sideways costs as much as two steps along the arrow
 CONE = 0.5  # within about 27 degrees of the arrow: sideways at most half as far as along it
-OUTSIDE_CONE = 1000.0  # an element outside the cone is taken only when none lies within
+WIDE_CONE = 3.0  # then within about 72 degrees; one nearly square to the arrow never
+OUTSIDE_CONE = 1000.0  # an element outside the narrow cone is taken only when none lies within
 
 
 def distance(a: tuple[float, float], b: tuple[float, float]) -> float:
     return abs(a[0] - b[0]) + ROW_CELLS * abs(a[1] - b[1])
 
 
-def nearest(centres: dict[Ref, tuple[float, float]], start: Ref, direction: tuple[int, int]) -> Ref | None:
+def nearest(centres: dict[Ref, tuple[float, float]], start: Ref, direction: tuple[int, int],
+            rows: dict[Ref, int] | None = None) -> Ref | None:
     """The element an arrow goes to from ``start``: among those ahead in ``direction`` (a unit step, (1, 0) right,
-    (0, 1) down), the one with the least distance along the arrow plus twice the distance across it, preferring
-    those within :data:`CONE` of it; None when nothing lies ahead."""
+    (0, 1) down), the one with the least distance along the arrow plus twice the distance across it. Left and right
+    first keep to the track ``start`` belongs to (its row in ``rows``: the track's line, for a label the track it is
+    written beside), within 45 degrees of the arrow; then come those within :data:`CONE` of the arrow, then those
+    within :data:`WIDE_CONE`. None when nothing lies that way (the cursor stays)."""
     x0, y0 = centres[start]
     ux, uy = direction
+    row = rows.get(start) if rows is not None and uy == 0 else None
     best: tuple[float, Ref] | None = None
     for ref, (x, y) in centres.items():
         dx, dy = x - x0, ROW_CELLS * (y - y0)
@@ -344,7 +385,26 @@ def nearest(centres: dict[Ref, tuple[float, float]], start: Ref, direction: tupl
         if ref == start or along <= 0:
             continue
         across = abs(dx * uy) + abs(dy * ux)
-        score = along + OFF_AXIS * across + (OUTSIDE_CONE if across > CONE * along else 0.0)
+        if row is not None and rows is not None and rows.get(ref) == row and across <= along:
+            tier = 0.0
+        elif across <= CONE * along:
+            tier = OUTSIDE_CONE
+        elif across <= WIDE_CONE * along:
+            tier = 2 * OUTSIDE_CONE
+        else:
+            continue  # nearly square to the arrow: not where it points
+        score = tier + along + OFF_AXIS * across
         if best is None or score < best[0]:
             best = (score, ref)
     return best[1] if best is not None else None
+
+
+def track_lines(lay: Layout) -> list[int]:
+    """The lines a track is drawn along (its band), top to bottom."""
+    return [y for y, line in enumerate(lay.grid) if any(g is not None and g.role == "band" for g in line)]
+
+
+def row_of(y: float, lines: list[int]) -> int:
+    """The track line nearest the line ``y``: a label's is the track it is written beside (on a tie, the one
+    below)."""
+    return min(lines, key=lambda line: (abs(line - y), line < y)) if lines else round(y)

@@ -221,6 +221,7 @@ answer line), Enter presses it. Shift+arrows or the wheel pan;
 + - zoom, 0 fits.   : command bar (Tab, Up/Down, Esc), e.g. {example}
 space pause/run   . one cycle   > < speed   a acknowledge alarms
 m mute / unmute the alarm bell (or 'mute' / 'unmute' in the bar)
+e the exercise's briefing and goals   ctrl+p every action by name
 F2 instructor panel   ? this help   ctrl+q quit (asks first)
 Esc also stops a long 'run' typed in the command bar
 Replay: [ ] seek 10 s, { } 60 s, Home / End

@@ -15,6 +15,7 @@ from liansuo.kit.printable import printable
 from liansuo.kit.source import StationError
 from liansuo.simulation.recording.recorder import FileRecorder
 from liansuo.simulation.sim import Simulation
+from liansuo.tui.briefing import Briefing, BriefingScreen
 from liansuo.tui.consolesim import ConsoleSim
 from liansuo.tui.dialogs import PasswordScreen
 from liansuo.tui.instructor import InstructorPanel
@@ -48,6 +49,11 @@ class LessonControls:
         def stop_run(self) -> None: ...
         def refresh_views(self) -> None: ...
         def push_screen(self, screen: Any, callback: Any = None) -> Any: ...
+        def refresh_bindings(self) -> None: ...
+
+    def exercise_files(self) -> list[Path]:
+        """The exercises the instructor may load: the bundled ones, and the one the console was started with."""
+        return self._exercise_files()
 
     def _exercise_files(self) -> list[Path]:
         """The panel's exercises: the bundled ones for this console's station, and the one it was started with."""
@@ -87,13 +93,18 @@ class LessonControls:
             self.instructor_panel.set_class(on, "-shown")
         self.say("instructor mode: faults, trains and exercises in the panel on the right (F2 closes it)" if on
                  else "trainee mode")
+        self.refresh_bindings()
         self.refresh_views()
 
     def on_instructor_panel_send(self, event: InstructorPanel.Send) -> None:
         self.send(event.line, "instructor")
 
     def on_instructor_panel_load_exercise(self, event: InstructorPanel.LoadExercise) -> None:
-        self.load_exercise(event.path)
+        self.load_chosen_exercise(event.path)
+
+    def load_chosen_exercise(self, path: str) -> None:
+        """The instructor chose an exercise (the panel's Load, the palette): this console loads it."""
+        self.load_exercise(path)
 
     def load_exercise(self, path: str) -> None:
         self.stop_run()
@@ -119,8 +130,10 @@ class LessonControls:
         self.log_panel.add(f"{self.sim.t:9.2f} {'lesson':8} {ex.title}: {ex.briefing} (seed {seed})", "#d0a0ff")
         for line in ex.lines(seed):
             self.send(line, "exercise")
-        self.say(f"exercise: {ex.title}. Goal: {ex.goal}")
+        self.say(f"exercise: {ex.title} (e shows the briefing and the goals again)")
         self.check_exercise()
+        self.refresh_bindings()  # the footer's 'e briefing'
+        self.show_briefing()
 
     def check_exercise(self) -> None:
         ex = self.exercise
@@ -132,6 +145,26 @@ class LessonControls:
             self.log_panel.add(f"{self.sim.t:9.2f} {'lesson':8} goal reached: {ex.goal}", "bold #40e070")
             self.say(f"goal reached: {ex.goal}", True)
         self._show_goal()
+
+    def briefing(self) -> Briefing | None:
+        """The exercise's briefing and its goals as they stand (None: no exercise)."""
+        ex = self.exercise
+        if ex is None:
+            return None
+        goals = [(g.description, i in self.goals_met) for i, g in enumerate(ex.goals)]
+        return Briefing(ex.title, ex.briefing, goals, "goal reached" if self.goal_reached_at is not None else "")
+
+    def show_briefing(self) -> None:
+        briefing = self.briefing()
+        if briefing is not None and not isinstance(self.screen_stack[-1], BriefingScreen):
+            self.push_screen(BriefingScreen(briefing))
+
+    def action_briefing(self) -> None:
+        """``e``: the briefing and the goals again."""
+        if self.briefing() is None:
+            self.say("no exercise has started on this console")
+            return
+        self.show_briefing()
 
     def _show_goal(self) -> None:
         ex, goal = self.exercise, self.goal
