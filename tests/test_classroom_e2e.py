@@ -127,6 +127,9 @@ def test_two_trainees_at_terminals_the_instructor_and_a_scored_report(room: Clas
         reply = teacher.request({"type": "exercise", "seats": [2], "name": "jiaopei-cancel-route", "seed": 1})
         assert reply["type"] == "ok", reply
         until(lambda: "Cancel a wrong route" in screen("Wang"), what="Wang told of the exercise")
+        until(lambda: "Esc / Enter closes" in screen("Wang"), what="the briefing in its dialog")
+        subprocess.run([*TMUX, "send-keys", "-t", "Wang", "Escape"], check=True)  # read: back to the console
+        until(lambda: "Esc / Enter closes" not in screen("Wang"), what="the briefing closed")
         type_in("Wang", "cancel X")
         time.sleep(1.0)
         type_in("Wang", "route X XI")
