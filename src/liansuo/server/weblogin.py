@@ -13,21 +13,18 @@ import asyncio
 import json
 import secrets
 import ssl
-import time
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from typing import Any
 
 from websockets.asyncio.client import connect
 from websockets.exceptions import WebSocketException
 
-from liansuo.classroom.passwords import matches
 from liansuo.server.lockout import LoginGuard
+from liansuo.server.passwordcheck import PasswordCheck
 
 SESSION_S = 12 * 3600.0  # a login serves for a school day: its tab reloaded, or reopened, gets its console again
 MAX_SESSIONS = 512  # past it, the oldest sessions without a console are forgotten
 MAX_DIALS = 8  # logins and lobbies asked of the classroom server at once; more are told to try again
-MAX_CHECKS = 16  # instructor password checks waiting or running at once
 DIAL_TIMEOUT_S = 5.0
 
 
@@ -83,11 +80,8 @@ class Desk:
 
     def __init__(self, ws_url: str, tls: ssl.SSLContext | None, instructor_hash: str, guard: LoginGuard) -> None:
         self.ws_url, self.tls = ws_url, tls
-        self.instructor_hash = instructor_hash
-        self.guard = guard
+        self.passwords = PasswordCheck(instructor_hash, guard, "liansuo-web-password")
         self._dials = 0
-        self._checks = 0
-        self._hasher = ThreadPoolExecutor(1, thread_name_prefix="liansuo-web-password")
 
     async def ask(self, message: dict[str, Any]) -> dict[str, Any]:
         """One message to the classroom server, as the first of a connection, and its reply (then it closes)."""
@@ -123,19 +117,8 @@ class Desk:
         return str(reply.get("token", ""))
 
     async def instructor(self, password: str, address: str) -> None:
-        """Refused unless ``password`` is the instructor's and ``address`` may try it now."""
-        if self._checks >= MAX_CHECKS:
-            raise Refused("the server is busy checking instructor passwords: try again in a few seconds")
-        no = self.guard.begin(address, time.monotonic())
-        if no is not None:
-            raise Refused(no)
-        self._checks += 1
-        ok = False
-        try:
-            ok = await asyncio.get_running_loop().run_in_executor(self._hasher, matches, password,
-                                                                  self.instructor_hash)
-        finally:
-            self._checks -= 1
-            locked = self.guard.end(address, ok, time.monotonic())
-        if not ok:
-            raise Refused(f"wrong instructor password{f': {locked}' if locked else ''}")
+        """Refused unless ``password`` is the instructor's and ``address`` may try it now (:class:`.PasswordCheck`,
+        as the classroom server checks it)."""
+        why = await self.passwords.refusal(password, address)
+        if why is not None:
+            raise Refused(why)

@@ -21,7 +21,6 @@ import time
 import traceback
 import weakref
 from collections.abc import Coroutine
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from http import HTTPStatus
 from typing import Any
@@ -32,7 +31,6 @@ from websockets.exceptions import ConnectionClosed
 from websockets.http11 import Request, Response
 from websockets.protocol import State
 
-from liansuo.classroom.passwords import matches
 from liansuo.classroom.roles import INSTRUCTOR, TRAINEE
 from liansuo.classroom.snapshot import EventCursor
 from liansuo.server.classroom import Classroom, SeatError
@@ -51,6 +49,7 @@ from liansuo.server.messages import (
     message_id,
     problem,
 )
+from liansuo.server.passwordcheck import PasswordCheck
 from liansuo.server.throttle import BURST, RATE, TokenBucket
 
 TICK_S = 0.05  # the clocks' pace on the wall clock
@@ -58,7 +57,6 @@ PUSH_S = 0.25  # a snapshot to each client this often
 MAX_MESSAGE = 64 * 1024
 HELLO_TIMEOUT_S = 10.0
 MAX_ADDRESSES = 10_000  # addresses remembered with connections open
-MAX_CHECKS = 16  # instructor password checks waiting or running at once, from every address together
 
 
 @dataclass
@@ -83,32 +81,40 @@ class ClassroomServer:
         ``failures`` and ``lockout_s``: the wrong passwords from one address before it is locked out, and for how
         long at first (:class:`.LoginGuard`)."""
         self.classroom = classroom
-        self.instructor_hash = instructor_hash
         self.errors = 0  # unexpected errors answered and survived (their tracebacks went to stderr)
         TokenBucket(0.0, rate, burst)  # a rate or burst it cannot use is refused here, not at the first message
         self.rate, self.burst = rate, burst
-        self.guard = LoginGuard(failures, lockout_s)
+        self.passwords = PasswordCheck(instructor_hash, LoginGuard(failures, lockout_s), "liansuo-password")
+        self.guard = self.passwords.guard
         self.clients: dict[ServerConnection, Client] = {}
-        self._checks = 0  # password checks waiting or running
-        self._hasher: ThreadPoolExecutor | None = None  # the password checks' one thread, while serving
         self._tasks: set[asyncio.Task[None]] = set()
         # connections from one address at once: every seat's console and its redial, the browsers' logins, the
         # instructor; past it a connection is refused before its websocket opens, so a wave of them costs little
         self.per_address = 2 * len(classroom.seats) + 16
         self._by_address: dict[str, weakref.WeakSet[ServerConnection]] = {}
 
+    @property
+    def instructor_hash(self) -> str:
+        """The hash the instructor's password is checked against (a server restarted may be given another)."""
+        return self.passwords.instructor_hash
+
+    @instructor_hash.setter
+    def instructor_hash(self, value: str) -> None:
+        self.passwords.instructor_hash = value
+
     # ---- the loop -------------------------------------------------------------------------------------------------
     async def serve(self, host: str, port: int, ready: asyncio.Future[int] | None = None,
                     tls: ssl.SSLContext | None = None) -> None:
         """Serve until cancelled; ``ready`` gets the port listened on (useful with port 0); with ``tls``, wss://."""
-        with ThreadPoolExecutor(1, thread_name_prefix="liansuo-password") as hasher:
-            self._hasher = hasher
+        try:
             async with serve(self.handle, host, port, max_size=MAX_MESSAGE, ssl=tls,
                              process_request=self.admit_connection) as server:
                 bound = next(iter(server.sockets)).getsockname()[1]
                 if ready is not None:
                     ready.set_result(bound)
                 await self.run_clocks()
+        finally:
+            self.passwords.close()
 
     def admit_connection(self, ws: ServerConnection, request: Request) -> Response | None:
         """Before the websocket opens: refused (429) when its address has :attr:`per_address` connections open."""
@@ -201,24 +207,11 @@ class ClassroomServer:
         return Client(TRAINEE, hello.seat, token)
 
     async def check_password(self, password: str | None, address: str) -> None:
-        """Raise SeatError unless ``password`` is the instructor's and ``address`` may try it now. The scrypt check
-        runs on a thread of its own, one at a time: the event loop, and every seat's class, go on meanwhile."""
-        if self._checks >= MAX_CHECKS:
-            raise SeatError("the server is busy checking instructor passwords: try again in a few seconds")
-        no = self.guard.begin(address, time.monotonic())
-        if no is not None:
-            raise SeatError(no)
-        self._checks += 1
-        ok = False
-        try:
-            if password is not None:
-                ok = await asyncio.get_running_loop().run_in_executor(self._hasher, matches, password,
-                                                                      self.instructor_hash)
-        finally:
-            self._checks -= 1
-            locked = self.guard.end(address, ok, time.monotonic())
-        if not ok:
-            raise SeatError(f"wrong instructor password{f': {locked}' if locked else ''}")
+        """Raise SeatError unless ``password`` is the instructor's and ``address`` may try it now
+        (:class:`.PasswordCheck`: off the event loop, with the lockout)."""
+        why = await self.passwords.refusal(password, address)
+        if why is not None:
+            raise SeatError(why)
 
     async def push(self, ws: ServerConnection, client: Client) -> None:
         n = 0
