@@ -4,7 +4,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: run test test-lowest test-newest lint clean native test-native docs
+.PHONY: run test test-slow test-lowest test-newest lint clean native test-native docs
 
 # Reinstall only when pyproject.toml or setup.py changed since the last install. The sumo extra (libsumo,
 # eclipse-sumo, about 230 MB) is installed too where it can be; where it cannot, the SUMO engine's tests skip and say
@@ -30,6 +30,11 @@ test: $(STAMP)
 # The documentation site with the API reference from the docstrings (mkdocs.yml), into site/.
 docs: $(STAMP)
 	$(BIN)/mkdocs build --strict
+
+# The long equivalence and exploration checks (marker slow): a quiet cycle against the full one on every station and
+# script, every mutant caught, explore's reductions against its full search. CI runs them after make test.
+test-slow: $(STAMP)
+	$(BIN)/python -m pytest -n auto --dist worksteal -m slow -rs
 
 # The wheel in a fresh environment outside the checkout (tests/test_wheel.py), its dependencies installed by uv at the
 # lowest versions pyproject.toml allows (lowest-direct: each at its floor, on Python 3.11, which uv fetches if it is

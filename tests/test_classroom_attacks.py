@@ -138,7 +138,9 @@ def test_the_lobby_names_nobody_and_a_name_with_control_characters_is_refused(ur
 
 
 # ---- 2. bounded memory ----------------------------------------------------------------------------------------------
-def test_a_hundred_thousand_commands_keep_the_log_at_its_bound() -> None:
+def test_twenty_thousand_commands_keep_the_log_at_its_bound() -> None:
+    """The log and the exercise's lists stop at their bounds however many commands come; memory stays flat. (Kept,
+    the 18,000 commands after the first 2,000 would take some 10 MB; liansuo bench measures 100,000.)"""
     room = Classroom("jiaopei", 1)
     try:
         room.start_exercise([1], "jiaopei-cancel-route", seed=1)
@@ -146,21 +148,21 @@ def test_a_hundred_thousand_commands_keep_the_log_at_its_bound() -> None:
         line = "route NOSUCH X # " + "x" * (MAX_LINE - 20)  # refused by the interlocking, never ends the exercise
         tracemalloc.start()
         try:
-            for _ in range(10_000):
+            for _ in range(2_000):
                 room.command(1, "trainee", line)
             before = tracemalloc.get_traced_memory()[0]
-            for _ in range(90_000):
+            for _ in range(18_000):
                 room.command(1, "trainee", line)
             grown = tracemalloc.get_traced_memory()[0] - before
         finally:
             tracemalloc.stop()
         a = seat.desk.assessment
         assert a is not None and not a.finished
-        print(f"\n100,000 commands of {len(line)} characters: memory grew {grown / 1e3:.0f} kB over the last 90,000")
-        assert len(seat.log) == LOG_LINES and seat.commands == 100_000 and seat.refused == 100_000
-        assert len(a.entries) == KEPT and a.report()["commands_not_kept"] == 100_000 - KEPT
-        assert a.progress()["refused"] == 100_000
-        assert grown < 1_000_000, f"{grown} bytes more after 90,000 commands: something keeps every command"
+        print(f"\n20,000 commands of {len(line)} characters: memory grew {grown / 1e3:.0f} kB over the last 18,000")
+        assert len(seat.log) == LOG_LINES and seat.commands == 20_000 and seat.refused == 20_000
+        assert len(a.entries) == KEPT and a.report()["commands_not_kept"] == 20_000 - KEPT
+        assert a.progress()["refused"] == 20_000
+        assert grown < 1_000_000, f"{grown} bytes more after 18,000 commands: something keeps every command"
     finally:
         room.close()
 

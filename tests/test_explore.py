@@ -39,6 +39,7 @@ def explore(station: str, depth: int, bounds: Bounds = SMALL, *, reduce: bool = 
         return ex, search(st, expand_here(ex), ex.root_key, depth, first=first)
 
 
+@pytest.mark.slow  # make test-slow (CI runs it after make test)
 def test_the_bounded_model_of_the_minimal_station_saturates_with_no_violation() -> None:
     _, out = explore(MINIMAL, 40)
     assert out.saturated and out.findings == {}  # type: ignore[attr-defined]
@@ -101,6 +102,7 @@ def test_every_explored_sequence_replays_on_a_fresh_simulation_to_the_state_it_w
     assert checked > 200
 
 
+@pytest.mark.slow  # make test-slow (CI runs it after make test)
 @pytest.mark.parametrize("station", [MINIMAL, PODAO])
 def test_the_partial_order_reduction_reaches_every_state_the_full_search_does(station: str) -> None:
     bounds = Bounds(routes=2, faults=1, occupied=2, turnout_marks=1, guide_locks=1)

@@ -13,6 +13,7 @@ from liansuo.proving.mutation.cli import default_stations, first_where_it_shows,
 from liansuo.proving.mutation.mutants import MUTANTS
 
 
+@pytest.mark.slow  # make test-slow (CI runs it after make test)
 def test_at_least_twenty_distinct_defects_and_95_percent_caught() -> None:
     assert len(MUTANTS) >= 20 and len({m.name for m in MUTANTS}) == len(MUTANTS)
     results = run_mutants()

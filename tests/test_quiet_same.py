@@ -41,6 +41,8 @@ from liansuo.simulation.world import World
 from liansuo.stations.loader import load
 from liansuo.stations.station import Station
 
+pytestmark = pytest.mark.slow  # make test-slow (CI runs it after make test)
+
 _LEFT_OUT = (OpenMemo, SettingMemo, ReleaseMemo, Reads)  # caches of a route's reads, by the cycle
 _CLOCK = ("now", "cycles")
 _CACHES = ("_door_sections", "_throat_platforms")  # filled on first use: a lookup, not a state

@@ -46,7 +46,7 @@ def test_check_fits_100_columns(station: str) -> None:
                                   ("run", "src/liansuo/examples/scenarios/jiaopei-receive-depart.yaml"),
                                   ("test", "src/liansuo/examples/scripts/jiaopei-interlocking-test.yaml"),
                                   ("test", "-v", "src/liansuo/examples/scripts/dead-zone-hazard.yaml"),
-                                  ("mutate", "--list"), ("exercise", "list"), ("zpw", "validate"),
+                                  ("mutate", "--list"), ("exercise", "list"),
                                   ("explore", "src/liansuo/examples/stations/minimal.yaml", "--depth", "2")])
 def test_text_commands_fit_100_columns(args: tuple[str, ...]) -> None:
     out = liansuo(*args)
